@@ -1,0 +1,58 @@
+//! Errors of the core crate.
+//!
+//! A reader never panics on bad input: it returns a [`ParseError`] that names
+//! the file, the 1-based line and column, and what was expected there, so the
+//! user can open the file at that spot.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// Where in a text file something went wrong (1-based line and column).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    pub path: PathBuf,
+    pub line: usize,
+    pub column: usize,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.path.display(), self.line, self.column)
+    }
+}
+
+/// A file that does not follow its format: where, and what was expected.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{location}: {message}")]
+pub struct ParseError {
+    pub location: Location,
+    pub message: String,
+}
+
+/// Any error of the core crate.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Parse(#[from] ParseError),
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A request that does not fit the data (a joint that does not exist, a
+    /// frame range outside the take, a body part the rig lacks...).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl Error {
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,95 @@
+//! Forward kinematics: global joint positions and rotations for every frame.
+//!
+//! For joint `j` with parent `p`, local rotation `q_j` and local translation
+//! `t_j` (offset or position channels):
+//!
+//! ```text
+//! R_j = R_p * q_j
+//! x_j = x_p + R_p * t_j
+//! ```
+//!
+//! and a root has `R_j = q_j`, `x_j = t_j`.
+
+use crate::motion::{local_rotation_of, Motion};
+use crate::rotation::{Quat, Vec3};
+
+/// Global joint positions and rotations, frame after frame
+/// (`frame * joint_count + joint`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlobalPoses {
+    pub joint_count: usize,
+    pub frame_count: usize,
+    pub positions: Vec<Vec3>,
+    pub rotations: Vec<Quat>,
+}
+
+impl GlobalPoses {
+    pub fn position(&self, frame: usize, joint: usize) -> Vec3 {
+        self.positions[frame * self.joint_count + joint]
+    }
+
+    pub fn rotation(&self, frame: usize, joint: usize) -> Quat {
+        self.rotations[frame * self.joint_count + joint]
+    }
+
+    /// The positions of all joints in one frame.
+    pub fn frame_positions(&self, frame: usize) -> &[Vec3] {
+        &self.positions[frame * self.joint_count..(frame + 1) * self.joint_count]
+    }
+
+    /// The rotations of all joints in one frame.
+    pub fn frame_rotations(&self, frame: usize) -> &[Quat] {
+        &self.rotations[frame * self.joint_count..(frame + 1) * self.joint_count]
+    }
+}
+
+/// Global poses of every frame of `motion`.
+pub fn forward_kinematics(motion: &Motion) -> GlobalPoses {
+    let skeleton = motion.skeleton();
+    let n = skeleton.joint_count();
+    let frames = motion.frame_count();
+    let mut positions = Vec::with_capacity(n * frames);
+    let mut rotations = Vec::with_capacity(n * frames);
+    for f in 0..frames {
+        let base = positions.len();
+        for (j, joint) in skeleton.joints().iter().enumerate() {
+            let values = motion.joint_values(f, j);
+            let local = local_rotation_of(&joint.channels, values);
+            let translation = motion.local_translation(f, j);
+            let (rotation, position) = match joint.parent {
+                Some(p) => {
+                    let (rp, xp) = (rotations[base + p], positions[base + p]);
+                    (rp * local, xp + rp * translation)
+                }
+                None => (local, translation),
+            };
+            rotations.push(rotation);
+            positions.push(position);
+        }
+    }
+    GlobalPoses {
+        joint_count: n,
+        frame_count: frames,
+        positions,
+        rotations,
+    }
+}
+
+/// Global positions of the end sites of every joint in one frame, as
+/// `(joint, position)` pairs in skeleton order.
+pub fn end_site_positions(
+    motion: &Motion,
+    poses: &GlobalPoses,
+    frame: usize,
+) -> Vec<(usize, Vec3)> {
+    let mut out = Vec::new();
+    for (j, joint) in motion.skeleton().joints().iter().enumerate() {
+        for &offset in &joint.end_sites {
+            out.push((
+                j,
+                poses.position(frame, j) + poses.rotation(frame, j) * offset,
+            ));
+        }
+    }
+    out
+}

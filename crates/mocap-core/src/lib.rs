@@ -1,0 +1,26 @@
+//! # mocap-core
+//!
+//! The motion core shared by every mocap capability:
+//!
+//! - [`skeleton`] and [`motion`]: the data model (joints, channels, frames);
+//! - [`rotation`]: every rotation conversion, written once;
+//! - [`kinematics`]: forward kinematics;
+//! - [`bodymap`]: semantic body parts located by joint name, and mirroring;
+//! - [`ops`]: resample, trim, mirror, scale;
+//! - [`metrics`]: position and rotation errors, bone-length statistics;
+//! - [`io`]: BVH and ASF/AMC files, and atomic writes.
+
+pub mod bodymap;
+pub mod error;
+pub mod io;
+pub mod kinematics;
+pub mod metrics;
+pub mod motion;
+pub mod ops;
+pub mod rotation;
+pub mod skeleton;
+
+pub use error::{Error, ParseError, Result};
+pub use kinematics::{forward_kinematics, GlobalPoses};
+pub use motion::Motion;
+pub use skeleton::{Channel, Joint, Skeleton};

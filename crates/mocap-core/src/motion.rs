@@ -1,0 +1,221 @@
+//! A motion: a skeleton, a frame time and the channel values of every frame.
+//!
+//! The channel values are kept exactly as read (rotations in degrees,
+//! positions in file units, columns in file order), so writing a motion back
+//! loses nothing. Root translation, local rotations and local translations are
+//! views computed from them.
+
+use crate::error::{Error, Result};
+use crate::rotation::{quat_to_euler_near, Axis, EulerOrder, Quat, Vec3};
+use crate::skeleton::{Channel, Skeleton};
+
+const DEG: f32 = std::f32::consts::PI / 180.0;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motion {
+    skeleton: Skeleton,
+    frame_time: f64,
+    frame_count: usize,
+    /// `frame_count * skeleton.channel_count()` values, frame after frame.
+    values: Vec<f32>,
+}
+
+impl Motion {
+    /// A motion from channel values laid out frame after frame. The frame
+    /// time is in seconds and must be positive.
+    pub fn new(
+        skeleton: Skeleton,
+        frame_time: f64,
+        frame_count: usize,
+        values: Vec<f32>,
+    ) -> Result<Motion> {
+        if !(frame_time.is_finite() && frame_time > 0.0) {
+            return Err(Error::Invalid(format!(
+                "frame time must be a positive number of seconds, got {frame_time}"
+            )));
+        }
+        let expected = frame_count * skeleton.channel_count();
+        if values.len() != expected {
+            return Err(Error::Invalid(format!(
+                "{frame_count} frames of {} channels need {expected} values, got {}",
+                skeleton.channel_count(),
+                values.len()
+            )));
+        }
+        Ok(Motion {
+            skeleton,
+            frame_time,
+            frame_count,
+            values,
+        })
+    }
+
+    /// A motion of `frame_count` frames in which every joint is at its rest
+    /// offset with no rotation.
+    pub fn rest(skeleton: Skeleton, frame_time: f64, frame_count: usize) -> Result<Motion> {
+        let mut frame = vec![0.0; skeleton.channel_count()];
+        for (j, joint) in skeleton.joints().iter().enumerate() {
+            let start = skeleton.channel_start(j);
+            for (k, c) in joint.channels.iter().enumerate() {
+                if c.is_position() {
+                    frame[start + k] = joint.offset[c.axis() as usize];
+                }
+            }
+        }
+        let values = frame.repeat(frame_count);
+        Motion::new(skeleton, frame_time, frame_count, values)
+    }
+
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// Seconds between frames, as written in the file.
+    pub fn frame_time(&self) -> f64 {
+        self.frame_time
+    }
+
+    /// Frames per second.
+    pub fn fps(&self) -> f64 {
+        1.0 / self.frame_time
+    }
+
+    pub fn frame_count(&self) -> usize {
+        self.frame_count
+    }
+
+    /// Length of the take in seconds (`frame_count * frame_time`).
+    pub fn duration(&self) -> f64 {
+        self.frame_count as f64 * self.frame_time
+    }
+
+    /// All channel values, frame after frame.
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// The channel values of one frame.
+    pub fn frame(&self, frame: usize) -> &[f32] {
+        let n = self.skeleton.channel_count();
+        &self.values[frame * n..(frame + 1) * n]
+    }
+
+    pub fn frame_mut(&mut self, frame: usize) -> &mut [f32] {
+        let n = self.skeleton.channel_count();
+        &mut self.values[frame * n..(frame + 1) * n]
+    }
+
+    /// Splits into skeleton, frame time, frame count and values.
+    pub fn into_parts(self) -> (Skeleton, f64, usize, Vec<f32>) {
+        (
+            self.skeleton,
+            self.frame_time,
+            self.frame_count,
+            self.values,
+        )
+    }
+
+    /// The channel values of `joint` in `frame`, in the joint's channel order.
+    pub fn joint_values(&self, frame: usize, joint: usize) -> &[f32] {
+        let start = self.skeleton.channel_start(joint);
+        let len = self.skeleton.joint(joint).channels.len();
+        &self.frame(frame)[start..start + len]
+    }
+
+    /// Local rotation of `joint` in `frame`: the product of its rotation
+    /// channels in the order listed (BVH rotations are intrinsic).
+    pub fn local_rotation(&self, frame: usize, joint: usize) -> Quat {
+        local_rotation_of(
+            &self.skeleton.joint(joint).channels,
+            self.joint_values(frame, joint),
+        )
+    }
+
+    /// Local translation of `joint` in `frame`: its position channels where it
+    /// has them (they replace the rest offset, as in BVH), else its offset.
+    pub fn local_translation(&self, frame: usize, joint: usize) -> Vec3 {
+        let j = self.skeleton.joint(joint);
+        let mut t = j.offset;
+        for (c, &v) in j.channels.iter().zip(self.joint_values(frame, joint)) {
+            if c.is_position() {
+                t[c.axis() as usize] = v;
+            }
+        }
+        t
+    }
+
+    /// Translation of the first root joint in `frame`.
+    pub fn root_translation(&self, frame: usize) -> Vec3 {
+        self.local_translation(frame, 0)
+    }
+
+    /// Sets the local rotation of `joint` in `frame` by rewriting its rotation
+    /// channels. The Euler angles are chosen nearest to the previous frame's so
+    /// that tracks stay continuous (no jumps of 360 degrees).
+    ///
+    /// A joint with fewer than three rotation channels can only hold rotations
+    /// about those axes: the rotation is decomposed with the missing axes last
+    /// and only the listed angles are kept. A joint without rotation channels
+    /// is left unchanged.
+    pub fn set_local_rotation(&mut self, frame: usize, joint: usize, rotation: Quat) {
+        let j = self.skeleton.joint(joint);
+        let listed: Vec<(usize, Axis)> = j
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.is_rotation())
+            .map(|(k, c)| (k, c.axis()))
+            .collect();
+        if listed.is_empty() {
+            return;
+        }
+        let mut axes: Vec<Axis> = listed.iter().map(|&(_, a)| a).collect();
+        for a in [Axis::X, Axis::Y, Axis::Z] {
+            if !axes.contains(&a) {
+                axes.push(a);
+            }
+        }
+        let order = EulerOrder::from_axes([axes[0], axes[1], axes[2]])
+            .expect("three distinct axes form an Euler order");
+        let start = self.skeleton.channel_start(joint);
+        let previous = if frame > 0 {
+            let prev = self.frame(frame - 1);
+            let mut p = Vec3::ZERO;
+            for (slot, &(k, _)) in listed.iter().enumerate() {
+                p[slot] = prev[start + k] * DEG;
+            }
+            p
+        } else {
+            Vec3::ZERO
+        };
+        let angles = quat_to_euler_near(order, rotation, previous);
+        let values = self.frame_mut(frame);
+        for (slot, &(k, _)) in listed.iter().enumerate() {
+            values[start + k] = angles[slot] / DEG;
+        }
+    }
+
+    /// Sets the position channels of `joint` in `frame`. A joint without
+    /// position channels keeps its offset.
+    pub fn set_local_translation(&mut self, frame: usize, joint: usize, translation: Vec3) {
+        let start = self.skeleton.channel_start(joint);
+        let channels = self.skeleton.joint(joint).channels.clone();
+        let values = self.frame_mut(frame);
+        for (k, c) in channels.iter().enumerate() {
+            if c.is_position() {
+                values[start + k] = translation[c.axis() as usize];
+            }
+        }
+    }
+}
+
+/// Rotation of a joint's channel values (degrees) in the order listed.
+pub(crate) fn local_rotation_of(channels: &[Channel], values: &[f32]) -> Quat {
+    let mut q = Quat::IDENTITY;
+    for (c, &v) in channels.iter().zip(values) {
+        if c.is_rotation() {
+            q *= c.axis().rotation(v * DEG);
+        }
+    }
+    q
+}
