@@ -1,0 +1,235 @@
+//! The Kinect v2 body layout: 25 joints, their kinematic tree, left/right
+//! mirror pairs and the per-joint tracking state.
+//!
+//! Joint indices are those of the Kinect for Windows SDK 2.0 `JointType`
+//! enumeration, which is also the joint order of NTU RGB+D `.skeleton` files.
+//!
+//! Note: `mocap_core::bodymap` is planned to carry the Kinect v2 layout; until
+//! it lands there this crate keeps its own copy here (one place, used by the
+//! whole crate), to be replaced by a re-export.
+
+use serde::{Deserialize, Serialize};
+
+/// Number of joints in a Kinect v2 body.
+pub const JOINT_COUNT: usize = 25;
+
+/// Joint names in SDK order.
+pub const JOINT_NAMES: [&str; JOINT_COUNT] = [
+    "SpineBase",
+    "SpineMid",
+    "Neck",
+    "Head",
+    "ShoulderLeft",
+    "ElbowLeft",
+    "WristLeft",
+    "HandLeft",
+    "ShoulderRight",
+    "ElbowRight",
+    "WristRight",
+    "HandRight",
+    "HipLeft",
+    "KneeLeft",
+    "AnkleLeft",
+    "FootLeft",
+    "HipRight",
+    "KneeRight",
+    "AnkleRight",
+    "FootRight",
+    "SpineShoulder",
+    "HandTipLeft",
+    "ThumbLeft",
+    "HandTipRight",
+    "ThumbRight",
+];
+
+/// Indices of the joints, for readable code.
+pub mod joint {
+    pub const SPINE_BASE: usize = 0;
+    pub const SPINE_MID: usize = 1;
+    pub const NECK: usize = 2;
+    pub const HEAD: usize = 3;
+    pub const SHOULDER_LEFT: usize = 4;
+    pub const ELBOW_LEFT: usize = 5;
+    pub const WRIST_LEFT: usize = 6;
+    pub const HAND_LEFT: usize = 7;
+    pub const SHOULDER_RIGHT: usize = 8;
+    pub const ELBOW_RIGHT: usize = 9;
+    pub const WRIST_RIGHT: usize = 10;
+    pub const HAND_RIGHT: usize = 11;
+    pub const HIP_LEFT: usize = 12;
+    pub const KNEE_LEFT: usize = 13;
+    pub const ANKLE_LEFT: usize = 14;
+    pub const FOOT_LEFT: usize = 15;
+    pub const HIP_RIGHT: usize = 16;
+    pub const KNEE_RIGHT: usize = 17;
+    pub const ANKLE_RIGHT: usize = 18;
+    pub const FOOT_RIGHT: usize = 19;
+    pub const SPINE_SHOULDER: usize = 20;
+    pub const HAND_TIP_LEFT: usize = 21;
+    pub const THUMB_LEFT: usize = 22;
+    pub const HAND_TIP_RIGHT: usize = 23;
+    pub const THUMB_RIGHT: usize = 24;
+}
+
+use joint::*;
+
+/// Parent of each joint in the Kinect v2 bone list (SDK sample
+/// `BodyBasics`); `None` for the root, `SpineBase`.
+pub const PARENTS: [Option<usize>; JOINT_COUNT] = [
+    None,                 // SpineBase
+    Some(SPINE_BASE),     // SpineMid
+    Some(SPINE_SHOULDER), // Neck
+    Some(NECK),           // Head
+    Some(SPINE_SHOULDER), // ShoulderLeft
+    Some(SHOULDER_LEFT),  // ElbowLeft
+    Some(ELBOW_LEFT),     // WristLeft
+    Some(WRIST_LEFT),     // HandLeft
+    Some(SPINE_SHOULDER), // ShoulderRight
+    Some(SHOULDER_RIGHT), // ElbowRight
+    Some(ELBOW_RIGHT),    // WristRight
+    Some(WRIST_RIGHT),    // HandRight
+    Some(SPINE_BASE),     // HipLeft
+    Some(HIP_LEFT),       // KneeLeft
+    Some(KNEE_LEFT),      // AnkleLeft
+    Some(ANKLE_LEFT),     // FootLeft
+    Some(SPINE_BASE),     // HipRight
+    Some(HIP_RIGHT),      // KneeRight
+    Some(KNEE_RIGHT),     // AnkleRight
+    Some(ANKLE_RIGHT),    // FootRight
+    Some(SPINE_MID),      // SpineShoulder
+    Some(HAND_LEFT),      // HandTipLeft
+    Some(WRIST_LEFT),     // ThumbLeft
+    Some(HAND_RIGHT),     // HandTipRight
+    Some(WRIST_RIGHT),    // ThumbRight
+];
+
+/// The joints in an order where every parent comes before its children (the
+/// SDK order does not: `SpineShoulder`, index 20, is the parent of `Neck`).
+pub const TOPOLOGICAL_ORDER: [usize; JOINT_COUNT] = [
+    SPINE_BASE,
+    SPINE_MID,
+    SPINE_SHOULDER,
+    NECK,
+    HEAD,
+    SHOULDER_LEFT,
+    ELBOW_LEFT,
+    WRIST_LEFT,
+    HAND_LEFT,
+    HAND_TIP_LEFT,
+    THUMB_LEFT,
+    SHOULDER_RIGHT,
+    ELBOW_RIGHT,
+    WRIST_RIGHT,
+    HAND_RIGHT,
+    HAND_TIP_RIGHT,
+    THUMB_RIGHT,
+    HIP_LEFT,
+    KNEE_LEFT,
+    ANKLE_LEFT,
+    FOOT_LEFT,
+    HIP_RIGHT,
+    KNEE_RIGHT,
+    ANKLE_RIGHT,
+    FOOT_RIGHT,
+];
+
+/// The mirror joint of each joint (left <-> right; the spine maps to itself).
+pub const MIRROR: [usize; JOINT_COUNT] = [
+    SPINE_BASE,
+    SPINE_MID,
+    NECK,
+    HEAD,
+    SHOULDER_RIGHT,
+    ELBOW_RIGHT,
+    WRIST_RIGHT,
+    HAND_RIGHT,
+    SHOULDER_LEFT,
+    ELBOW_LEFT,
+    WRIST_LEFT,
+    HAND_LEFT,
+    HIP_RIGHT,
+    KNEE_RIGHT,
+    ANKLE_RIGHT,
+    FOOT_RIGHT,
+    HIP_LEFT,
+    KNEE_LEFT,
+    ANKLE_LEFT,
+    FOOT_LEFT,
+    SPINE_SHOULDER,
+    HAND_TIP_RIGHT,
+    THUMB_RIGHT,
+    HAND_TIP_LEFT,
+    THUMB_LEFT,
+];
+
+/// The joint index of a Kinect v2 joint name (as in [`JOINT_NAMES`]).
+pub fn joint_index(name: &str) -> Option<usize> {
+    JOINT_NAMES.iter().position(|n| *n == name)
+}
+
+/// How well the sensor sees a joint (SDK `TrackingState`, NTU column 12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum TrackingState {
+    /// Not seen; the position is meaningless.
+    NotTracked = 0,
+    /// Not seen directly; the position is the tracker's guess (occluded).
+    Inferred = 1,
+    /// Seen.
+    Tracked = 2,
+}
+
+impl TrackingState {
+    /// The state of a numeric code 0, 1 or 2.
+    pub fn from_code(code: i64) -> Option<TrackingState> {
+        match code {
+            0 => Some(TrackingState::NotTracked),
+            1 => Some(TrackingState::Inferred),
+            2 => Some(TrackingState::Tracked),
+            _ => None,
+        }
+    }
+
+    /// The numeric code 0, 1 or 2.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topological_order_puts_parents_first_and_covers_every_joint() {
+        let mut seen = [false; JOINT_COUNT];
+        for &j in &TOPOLOGICAL_ORDER {
+            if let Some(p) = PARENTS[j] {
+                assert!(seen[p], "{} before its parent", JOINT_NAMES[j]);
+            }
+            assert!(!seen[j]);
+            seen[j] = true;
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn mirror_is_an_involution_that_swaps_sides() {
+        for j in 0..JOINT_COUNT {
+            assert_eq!(MIRROR[MIRROR[j]], j);
+            let name = JOINT_NAMES[j];
+            let other = JOINT_NAMES[MIRROR[j]];
+            if name.ends_with("Left") {
+                assert_eq!(other, name.replace("Left", "Right"));
+            } else if !name.ends_with("Right") {
+                assert_eq!(other, name);
+            }
+        }
+    }
+
+    #[test]
+    fn parents_of_mirror_joints_are_mirrors() {
+        for j in 0..JOINT_COUNT {
+            assert_eq!(PARENTS[MIRROR[j]], PARENTS[j].map(|p| MIRROR[p]));
+        }
+    }
+}
