@@ -1217,14 +1217,14 @@ fn read_amc_values(
             })?;
             check_frame(frame, &given)?;
             if let Some((previous, _)) = frame {
-                if frame_number != previous + 1 {
+                let expected = previous.saturating_add(1);
+                if frame_number != expected {
                     return Err(e.at_token(
                         number,
                         line,
                         first,
                         format!(
-                            "frame numbers out of sequence: expected {}, found {frame_number}",
-                            previous + 1
+                            "frame numbers out of sequence: expected {expected}, found {frame_number}"
                         ),
                     ));
                 }
