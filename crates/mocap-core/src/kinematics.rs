@@ -10,7 +10,7 @@
 //!
 //! and a root has `R_j = q_j`, `x_j = t_j`.
 
-use crate::motion::{local_rotation_of, Motion};
+use crate::motion::{local_rotation_of, local_translation_of, Motion};
 use crate::rotation::{Quat, Vec3};
 
 /// Global joint positions and rotations, frame after frame
@@ -37,6 +37,17 @@ impl GlobalPoses {
         &self.positions[frame * self.joint_count..(frame + 1) * self.joint_count]
     }
 
+    /// Smallest and largest coordinates over all joints and frames, or `None`
+    /// for a motion without frames.
+    pub fn bounding_box(&self) -> Option<(Vec3, Vec3)> {
+        let first = *self.positions.first()?;
+        Some(
+            self.positions
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+        )
+    }
+
     /// The rotations of all joints in one frame.
     pub fn frame_rotations(&self, frame: usize) -> &[Quat] {
         &self.rotations[frame * self.joint_count..(frame + 1) * self.joint_count]
@@ -50,12 +61,20 @@ pub fn forward_kinematics(motion: &Motion) -> GlobalPoses {
     let frames = motion.frame_count();
     let mut positions = Vec::with_capacity(n * frames);
     let mut rotations = Vec::with_capacity(n * frames);
+    let joints = skeleton.joints();
+    let spans: Vec<(usize, usize)> = (0..n)
+        .map(|j| {
+            let start = skeleton.channel_start(j);
+            (start, start + joints[j].channels.len())
+        })
+        .collect();
     for f in 0..frames {
+        let frame = motion.frame(f);
         let base = positions.len();
-        for (j, joint) in skeleton.joints().iter().enumerate() {
-            let values = motion.joint_values(f, j);
+        for (joint, &(start, end)) in joints.iter().zip(&spans) {
+            let values = &frame[start..end];
             let local = local_rotation_of(&joint.channels, values);
-            let translation = motion.local_translation(f, j);
+            let translation = local_translation_of(joint, values);
             let (rotation, position) = match joint.parent {
                 Some(p) => {
                     let (rp, xp) = (rotations[base + p], positions[base + p]);

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::rotation::{quat_to_euler_near, Axis, EulerOrder, Quat, Vec3};
-use crate::skeleton::{Channel, Skeleton};
+use crate::skeleton::{Channel, Joint, Skeleton};
 
 const DEG: f32 = std::f32::consts::PI / 180.0;
 
@@ -122,6 +122,25 @@ impl Motion {
         &self.frame(frame)[start..start + len]
     }
 
+    /// Appends the frames of `other`, which must have the same skeleton and
+    /// frame time (for joining takes of one recording session).
+    pub fn append(&mut self, other: &Motion) -> Result<()> {
+        if other.skeleton != self.skeleton {
+            return Err(Error::Invalid(
+                "cannot join motions with different skeletons".to_string(),
+            ));
+        }
+        if other.frame_time != self.frame_time {
+            return Err(Error::Invalid(format!(
+                "cannot join motions with different frame times ({} s and {} s)",
+                self.frame_time, other.frame_time
+            )));
+        }
+        self.values.extend_from_slice(&other.values);
+        self.frame_count += other.frame_count;
+        Ok(())
+    }
+
     /// Local rotation of `joint` in `frame`: the product of its rotation
     /// channels in the order listed (BVH rotations are intrinsic).
     pub fn local_rotation(&self, frame: usize, joint: usize) -> Quat {
@@ -134,14 +153,7 @@ impl Motion {
     /// Local translation of `joint` in `frame`: its position channels where it
     /// has them (they replace the rest offset, as in BVH), else its offset.
     pub fn local_translation(&self, frame: usize, joint: usize) -> Vec3 {
-        let j = self.skeleton.joint(joint);
-        let mut t = j.offset;
-        for (c, &v) in j.channels.iter().zip(self.joint_values(frame, joint)) {
-            if c.is_position() {
-                t[c.axis() as usize] = v;
-            }
-        }
-        t
+        local_translation_of(self.skeleton.joint(joint), self.joint_values(frame, joint))
     }
 
     /// Translation of the first root joint in `frame`.
@@ -209,7 +221,21 @@ impl Motion {
     }
 }
 
+/// Translation of a joint from its channel values: position channels replace
+/// the matching coordinates of the rest offset.
+#[inline]
+pub(crate) fn local_translation_of(joint: &Joint, values: &[f32]) -> Vec3 {
+    let mut t = joint.offset;
+    for (c, &v) in joint.channels.iter().zip(values) {
+        if c.is_position() {
+            t[c.axis() as usize] = v;
+        }
+    }
+    t
+}
+
 /// Rotation of a joint's channel values (degrees) in the order listed.
+#[inline]
 pub(crate) fn local_rotation_of(channels: &[Channel], values: &[f32]) -> Quat {
     let mut q = Quat::IDENTITY;
     for (c, &v) in channels.iter().zip(values) {

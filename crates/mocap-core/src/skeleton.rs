@@ -93,7 +93,10 @@ pub struct DofLimit {
 /// The limits hold for the Euler angles of the joint's local rotation
 /// expressed in its `axis_frame`: with `q` the joint's local rotation in this
 /// skeleton, the constrained rotation is `axis_frame^-1 * q * axis_frame`,
-/// decomposed in the order of `dofs`.
+/// decomposed as *intrinsic* Euler angles in the order of `dofs` (the same
+/// convention as BVH channels; the ASF reader lists `dof rx ry rz` as
+/// `rz ry rx` for this reason). Translation limits are in the motion's length
+/// unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RangeOfMotion {
     pub axis_frame: Quat,

@@ -2,8 +2,112 @@
 //!
 //! - [`bvh`]: Biovision Hierarchy, read and write;
 //! - [`asf_amc`]: Acclaim skeleton and motion (CMU, HDM05), read;
+//! - [`positions`]: global joint positions as CSV or JSON;
 //! - [`atomic`]: writing a file so that it is either whole or absent.
+//!
+//! [`read_motion`] picks the reader from the file names, so that every
+//! command accepts the same inputs.
 
 pub mod asf_amc;
 pub mod atomic;
 pub mod bvh;
+pub mod positions;
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::motion::Motion;
+
+/// The kinds of motion input a command accepts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum MotionSource {
+    /// One BVH file.
+    Bvh(PathBuf),
+    /// An ASF skeleton with one AMC motion of it.
+    AsfAmc { asf: PathBuf, amc: PathBuf },
+}
+
+impl MotionSource {
+    /// Groups command-line paths into motions: each `.bvh` is one motion; an
+    /// `.asf` pairs with every `.amc` that follows it (`X.asf A.amc B.amc`).
+    pub fn group(paths: &[PathBuf]) -> Result<Vec<MotionSource>> {
+        let mut sources = Vec::new();
+        let mut current_asf: Option<&PathBuf> = None;
+        for path in paths {
+            match extension(path).as_str() {
+                "bvh" => sources.push(MotionSource::Bvh(path.clone())),
+                "asf" => current_asf = Some(path),
+                "amc" => match current_asf {
+                    Some(asf) => sources.push(MotionSource::AsfAmc {
+                        asf: asf.clone(),
+                        amc: path.clone(),
+                    }),
+                    None => {
+                        return Err(Error::Invalid(format!(
+                        "{}: an AMC motion needs its ASF skeleton before it on the command line",
+                        path.display()
+                    )))
+                    }
+                },
+                _ => {
+                    return Err(Error::Invalid(format!(
+                        "{}: unknown motion file type (expected .bvh, or .asf followed by .amc)",
+                        path.display()
+                    )))
+                }
+            }
+        }
+        if let (Some(asf), false) = (
+            current_asf,
+            sources
+                .iter()
+                .any(|s| matches!(s, MotionSource::AsfAmc { .. })),
+        ) {
+            return Err(Error::Invalid(format!(
+                "{}: an ASF skeleton needs at least one AMC motion after it",
+                asf.display()
+            )));
+        }
+        Ok(sources)
+    }
+
+    /// A short name for messages and reports.
+    pub fn display_name(&self) -> String {
+        match self {
+            MotionSource::Bvh(p) => p.display().to_string(),
+            MotionSource::AsfAmc { amc, .. } => amc.display().to_string(),
+        }
+    }
+
+    pub fn read(&self) -> Result<Motion> {
+        match self {
+            MotionSource::Bvh(path) => bvh::read_bvh(path),
+            MotionSource::AsfAmc { asf, amc } => asf_amc::read_asf_amc(asf, amc),
+        }
+    }
+}
+
+/// Reads every motion named by `paths` (see [`MotionSource::group`]).
+pub fn read_motions(paths: &[PathBuf]) -> Result<Vec<(MotionSource, Motion)>> {
+    MotionSource::group(paths)?
+        .into_iter()
+        .map(|s| s.read().map(|m| (s, m)))
+        .collect()
+}
+
+/// Writes a motion to `path`, choosing the format from the extension.
+pub fn write_motion(path: &Path, motion: &Motion) -> Result<()> {
+    match extension(path).as_str() {
+        "bvh" => bvh::write_bvh(path, motion),
+        _ => Err(Error::Invalid(format!(
+            "{}: can only write .bvh motion files",
+            path.display()
+        ))),
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}

@@ -1,0 +1,26 @@
+"""Parse throughput of the Python package bvhio on BVH files (reference for bench/core.sh).
+
+Usage: python3 bench/bvhio_parse.py FILE...   (prints one JSON line)
+"""
+import json
+import os
+import sys
+import time
+
+import bvhio
+
+paths = sys.argv[1:]
+total_bytes = sum(os.path.getsize(p) for p in paths)
+start = time.perf_counter()
+frames = 0
+for p in paths:
+    frames += bvhio.readAsBvh(p).FrameCount
+seconds = time.perf_counter() - start
+print(json.dumps({
+    "tool": f"bvhio {getattr(bvhio, '__version__', '')}".strip(),
+    "files": len(paths),
+    "bytes": total_bytes,
+    "frames": frames,
+    "seconds": seconds,
+    "mb_per_s": total_bytes / 1e6 / seconds,
+}))

@@ -1,0 +1,90 @@
+//! Global joint positions as CSV or JSON, for spreadsheets, plotting and other
+//! tools.
+//!
+//! CSV: a header `frame,time,<joint>.x,<joint>.y,<joint>.z,...` then one row
+//! per frame. JSON: `{"frame_time": s, "joints": [names], "parents": [index or
+//! null], "positions": [[[x, y, z], ...per joint], ...per frame]}`.
+
+use std::io::Write;
+
+use crate::kinematics::GlobalPoses;
+use crate::motion::Motion;
+
+/// Writes the positions of every frame as CSV.
+pub fn write_positions_csv(
+    out: &mut dyn Write,
+    motion: &Motion,
+    poses: &GlobalPoses,
+) -> std::io::Result<()> {
+    write!(out, "frame,time")?;
+    for joint in motion.skeleton().joints() {
+        let name = csv_field(&joint.name);
+        write!(out, ",{name}.x,{name}.y,{name}.z")?;
+    }
+    writeln!(out)?;
+    for f in 0..poses.frame_count {
+        write!(out, "{f},{}", f as f64 * motion.frame_time())?;
+        for p in poses.frame_positions(f) {
+            write!(out, ",{},{},{}", p.x, p.y, p.z)?;
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+/// Writes the positions of every frame as one JSON object.
+pub fn write_positions_json(
+    out: &mut dyn Write,
+    motion: &Motion,
+    poses: &GlobalPoses,
+) -> std::io::Result<()> {
+    let skeleton = motion.skeleton();
+    write!(out, "{{\"frame_time\":{},\"joints\":[", motion.frame_time())?;
+    for (i, joint) in skeleton.joints().iter().enumerate() {
+        let sep = if i == 0 { "" } else { "," };
+        write!(out, "{sep}{}", json_string(&joint.name))?;
+    }
+    write!(out, "],\"parents\":[")?;
+    for (i, joint) in skeleton.joints().iter().enumerate() {
+        let sep = if i == 0 { "" } else { "," };
+        match joint.parent {
+            Some(p) => write!(out, "{sep}{p}")?,
+            None => write!(out, "{sep}null")?,
+        }
+    }
+    write!(out, "],\"positions\":[")?;
+    for f in 0..poses.frame_count {
+        write!(out, "{}[", if f == 0 { "" } else { "," })?;
+        for (j, p) in poses.frame_positions(f).iter().enumerate() {
+            let sep = if j == 0 { "" } else { "," };
+            write!(out, "{sep}[{},{},{}]", p.x, p.y, p.z)?;
+        }
+        write!(out, "]")?;
+    }
+    writeln!(out, "]}}")
+}
+
+/// Quotes a CSV field when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// A JSON string literal.
+fn json_string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
