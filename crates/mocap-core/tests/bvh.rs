@@ -486,7 +486,7 @@ fn joints_not_in_depth_first_order_are_written_with_their_own_values() {
 
 #[test]
 fn names_that_cannot_be_written_are_refused() {
-    for bad in ["", " Hips", "Hips\nJOINT", "Hips {"] {
+    for bad in ["", " Hips", "Hips\nJOINT", "Hips {", "A{B"] {
         let skeleton = Skeleton::new(vec![Joint::new(bad, None, Vec3::ZERO)]).unwrap();
         let motion = Motion::new(skeleton, 0.1, 0, vec![]).unwrap();
         let err = write_bvh_to(&mut Vec::new(), &motion).unwrap_err();
@@ -519,4 +519,27 @@ fn zero_frames_read_and_write() {
     let motion = read_bvh_from(Cursor::new(text), Path::new("empty-take")).unwrap();
     assert_eq!(motion.frame_count(), 0);
     assert_round_trip(&motion, "empty-take");
+}
+
+#[test]
+fn end_site_spellings_and_braces_on_the_same_line() {
+    for end_site in [
+        "End Site",
+        "END SITE",
+        "end site",
+        "EndSite",
+        "End Site {",
+        "End Site Hand_end",
+    ] {
+        let brace = if end_site.ends_with('{') { "" } else { "{" };
+        let text = format!(
+            "HIERARCHY\nROOT Hips {{\n OFFSET 0 0 0\n CHANNELS 1 Yrotation\n JOINT Hand {{ OFFSET 1 0 0\n  {end_site}\n  {brace} OFFSET 0 2 0\n  }}}}\n}}\nMOTION\nFrames: 1\nFrame Time: 0.1\n45\n"
+        );
+        let motion = read_bvh_from(Cursor::new(text), Path::new("end-site"))
+            .unwrap_or_else(|e| panic!("{end_site:?}: {e}"));
+        let hand = motion.skeleton().joint(1);
+        assert_eq!(hand.offset, Vec3::X, "{end_site:?}");
+        assert_eq!(hand.end_sites, [Vec3::new(0.0, 2.0, 0.0)], "{end_site:?}");
+        assert_eq!(motion.frame(0), [45.0]);
+    }
 }

@@ -47,9 +47,10 @@
 //! - tabs or spaces anywhere between words, `\n`, `\r\n` or a mix of both as
 //!   line ends, a UTF-8 byte order mark, blank lines anywhere;
 //! - keywords in any case (`ROOT`, `Root`, `End Site`, `END SITE`,
-//!   `Frame time:`), `{` on the `JOINT` line, a name after `End Site`;
+//!   `EndSite`, `Frame time:`), `{` on the `ROOT`/`JOINT`/`End Site` line,
+//!   `}}` for two closing braces, a name after `End Site`;
 //! - joint names with spaces or any bytes: the rest of the `ROOT`/`JOINT`
-//!   line is the name, and bytes that are not UTF-8 (Latin-1 names from old
+//!   line (up to a `{`) is the name, and bytes that are not UTF-8 (Latin-1 names from old
 //!   tools) are decoded lossily, never refused;
 //! - `Frames:` and `Frame Time:` in either order, followed by spaces or tabs,
 //!   with or without the colon; numbers such as `.0083333`, `-0.0000`,
@@ -119,8 +120,8 @@ pub fn write_bvh(path: &Path, motion: &Motion) -> Result<()> {
 /// Writes `motion` as BVH text.
 ///
 /// Fails with [`io::ErrorKind::InvalidInput`] when a joint name cannot be
-/// written so that it reads back the same (empty, with a line break, or with
-/// spaces at either end).
+/// written so that it reads back the same (empty, with a line break or a
+/// `{`, or with spaces at either end).
 pub fn write_bvh_to(writer: &mut dyn Write, motion: &Motion) -> io::Result<()> {
     let skeleton = motion.skeleton();
     let joints = skeleton.joints();
@@ -229,10 +230,8 @@ pub fn write_bvh_to(writer: &mut dyn Write, motion: &Motion) -> io::Result<()> {
 }
 
 fn check_writable_name(name: &str) -> io::Result<()> {
-    let bad = name.is_empty()
-        || name.contains(['\n', '\r'])
-        || name.trim() != name
-        || name.ends_with('{');
+    let bad =
+        name.is_empty() || name.contains(['\n', '\r']) || name.trim() != name || name.contains('{');
     if bad {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -355,19 +354,19 @@ impl<R: BufRead> Lines<R> {
         self.line.get(token.start..token.end).unwrap_or_default()
     }
 
-    /// The rest of the current line, trimmed, whether it ended with `{`
-    /// (which is then left out), and the column where it starts. Moves the
-    /// cursor to the end of the line.
-    fn rest_of_line(&mut self) -> (String, bool, usize) {
+    /// The text after a `ROOT`/`JOINT`/`End` keyword up to the end of the
+    /// line or to a `{`, trimmed; whether a `{` ended it; and the column where
+    /// the text starts. Moves the cursor after the `{` (the rest of the line,
+    /// such as `OFFSET ...`, is read as usual) or to the end of the line.
+    fn name_until_brace(&mut self) -> (String, bool, usize) {
         let rest = self.line.get(self.cursor..).unwrap_or_default();
         let column = self.cursor + 1 + (rest.len() - rest.trim_ascii_start().len());
-        let mut rest = rest.trim_ascii();
-        let brace = rest.last() == Some(&b'{');
-        if brace {
-            rest = rest[..rest.len() - 1].trim_ascii_end();
-        }
-        let text = String::from_utf8_lossy(rest).into_owned();
-        self.cursor = self.line.len();
+        let (name, brace, consumed) = match rest.iter().position(|&b| b == b'{') {
+            Some(at) => (&rest[..at], true, at + 1),
+            None => (rest, false, rest.len()),
+        };
+        let text = String::from_utf8_lossy(name.trim_ascii()).into_owned();
+        self.cursor += consumed;
         (text, brace, column)
     }
 
@@ -565,7 +564,7 @@ impl<R: BufRead> Parser<R> {
                         "JOINT outside of any ROOT block: expected ROOT or MOTION",
                     ));
                 }
-                let (name, brace, name_column) = self.lines.rest_of_line();
+                let (name, brace, name_column) = self.lines.name_until_brace();
                 if name.is_empty() {
                     return Err(self.lines.error_here(
                         self.lines.line.len() + 1,
@@ -590,16 +589,18 @@ impl<R: BufRead> Parser<R> {
                     index: joints.len() - 1,
                     line: token.line,
                 });
-            } else if is_keyword(word, "End") {
+            } else if is_keyword(word, "End") || is_keyword(word, "EndSite") {
+                let glued = is_keyword(word, "EndSite");
                 let Some(o) = open.last() else {
                     return Err(self.lines.error_at(token, "End Site outside of any joint"));
                 };
                 let joint = o.index;
-                let (rest, brace, _) = self.lines.rest_of_line();
-                let says_site = rest
-                    .split_ascii_whitespace()
-                    .next()
-                    .is_some_and(|w| w.eq_ignore_ascii_case("Site"));
+                let (rest, brace, _) = self.lines.name_until_brace();
+                let says_site = glued
+                    || rest
+                        .split_ascii_whitespace()
+                        .next()
+                        .is_some_and(|w| w.eq_ignore_ascii_case("Site"));
                 if !says_site {
                     return Err(self.lines.error_at(token, "expected `End Site`"));
                 }
@@ -702,7 +703,10 @@ impl<R: BufRead> Parser<R> {
             let word = self.lines.text(token);
             if is_keyword(word, "OFFSET") {
                 offset = self.parse_offset()?;
-            } else if word == b"}" {
+            } else if word.first() == Some(&b'}') && word.iter().all(|&b| b == b'}') {
+                // In `}}` the first brace closes the End Site; the next token
+                // starts at the second, which closes its joint.
+                self.lines.cursor = token.start + 1;
                 return Ok(offset);
             } else {
                 let found = show(word);
