@@ -270,6 +270,14 @@ fn unbalanced_braces() {
         1,
         "file ends inside joint \"Spine\" (opened at line 6)",
     );
+    // A second ROOT before the first is closed.
+    let nested_root = with_line(6, Some("  ROOT Spine"));
+    assert_error(
+        &nested_root,
+        6,
+        3,
+        "ROOT inside joint \"Hips\" (opened at line 2)",
+    );
     // A JOINT without `{`.
     let no_brace = with_line(7, Some("    OFFSET 1 1 1"));
     assert_error(&no_brace, 7, 5, "expected `{` after JOINT");
