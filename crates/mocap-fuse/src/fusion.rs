@@ -5,10 +5,11 @@
 //! [`FusionOptions`] can switch on what we found to help on top (each
 //! measured separately in the evaluation):
 //! - **left/right swap repair**: a Kinect that sees the person from behind
-//!   still believes it sees them from the front and swaps left and right. A
-//!   sensor whose hip and shoulder lines point against the previous fused
-//!   skeleton's (or, on the first frame, against the majority of sensors) has
-//!   its left and right labels swapped back before fusing;
+//!   still believes it sees them from the front and swaps left and right. The
+//!   person's facing is found from cues that do not depend on the labels (the
+//!   feet point forward), plus the previous fused skeleton's facing; a sensor
+//!   whose labelled skeleton faces the other way has its left and right
+//!   labels swapped back before fusing;
 //! - **robust rejection**: iteratively reweighted mean with Cauchy weights
 //!   `C_kn / (1 + (r_kn / c)^2)`, `r_kn` the distance of the sensor's joint to
 //!   the current fused joint, so one sensor that disagrees with the others
@@ -152,6 +153,12 @@ fn lateral(p: &[Vec3; JOINT_COUNT]) -> Vec3 {
     (p[SHOULDER_RIGHT] - p[SHOULDER_LEFT]) + (p[HIP_RIGHT] - p[HIP_LEFT])
 }
 
+/// The horizontal direction a skeleton faces according to its left/right
+/// labels (up cross left-to-right), unit length or zero.
+pub fn facing_of(p: &[Vec3; JOINT_COUNT]) -> Vec3 {
+    Vec3::Y.cross(lateral(p)).with_y(0.0).normalize_or_zero()
+}
+
 /// The skeleton with left and right labels exchanged.
 pub fn swap_left_right(
     joints: &[JointObservation; JOINT_COUNT],
@@ -233,38 +240,29 @@ impl Fuser {
     }
 
     fn repair_swaps(&self, views: &[SensorView], swapped: &mut Vec<u16>) -> Vec<SensorView> {
-        let laterals: Vec<Vec3> = views
-            .iter()
-            .map(|v| lateral(&v.joints.map(|j| j.position)).normalize_or_zero())
-            .collect();
-        let reference = match self.previous {
-            Some((_, prev)) => lateral(&prev),
-            None => {
-                // No past: the majority, each sensor counting by how many
-                // joints it tracks, taking the first as the sign reference.
-                let first = laterals[0];
-                let sum: Vec3 = views
-                    .iter()
-                    .zip(&laterals)
-                    .map(|(v, &l)| {
-                        let tracked = v
-                            .joints
-                            .iter()
-                            .filter(|j| j.state == TrackingState::Tracked)
-                            .count() as f32;
-                        let sign = if l.dot(first) >= 0.0 { 1.0 } else { -1.0 };
-                        sign * tracked
-                    })
-                    .map(|s| first * s)
-                    .sum();
-                sum
+        // Which way the person faces, from cues that do not depend on the
+        // left/right labels: the feet point forward (ankle to foot, both
+        // feet, every sensor that sees them), plus the previous fused
+        // skeleton's facing for continuity when the feet say little.
+        let mut forward = Vec3::ZERO;
+        for v in views {
+            for (ankle, foot) in [(ANKLE_LEFT, FOOT_LEFT), (ANKLE_RIGHT, FOOT_RIGHT)] {
+                let (a, f) = (v.joints[ankle], v.joints[foot]);
+                if a.state == TrackingState::Tracked && f.state == TrackingState::Tracked {
+                    forward +=
+                        ((f.position - a.position) * Vec3::new(1.0, 0.0, 1.0)).normalize_or_zero();
+                }
             }
-        };
+        }
+        let forward = forward.normalize_or_zero()
+            + self
+                .previous
+                .map_or(Vec3::ZERO, |(_, p)| facing_of(&p) * 0.5);
         views
             .iter()
-            .zip(&laterals)
-            .map(|(v, l)| {
-                if l.dot(reference) < 0.0 {
+            .map(|v| {
+                let labelled = facing_of(&v.joints.map(|j| j.position));
+                if labelled.dot(forward) < 0.0 {
                     swapped.push(v.sensor);
                     SensorView {
                         sensor: v.sensor,

@@ -20,8 +20,13 @@
 //! - [`confidence`]: the confidence terms;
 //! - [`fusion`]: the weighted fusion and what we add to it;
 
+pub mod align;
 pub mod body;
+pub mod calib;
 pub mod confidence;
+pub mod eval;
 pub mod fusion;
 pub mod kinect;
+pub mod offline;
 pub mod recording;
+pub mod sim;

@@ -1,0 +1,205 @@
+//! Offline fusion of recordings (`mocap fuse run`): sensor frames are put on
+//! a common clock and fused instant by instant.
+//!
+//! Sensors are not synchronised: each captures at its own phase. The fused
+//! skeleton is made on a regular grid of instants (the sensors' frame rate);
+//! at each instant a sensor contributes its skeleton linearly interpolated
+//! between its two frames around the instant (if they are at most
+//! `max_gap` apart: one dropped frame is bridged), with the worse of the two
+//! tracking states, or its nearest frame within half a period.
+
+use std::collections::BTreeMap;
+
+use crate::calib::Calibration;
+use crate::fusion::{FusedFrame, Fuser, SensorView};
+use crate::kinect::JOINT_COUNT;
+use crate::recording::{JointObservation, SensorFrame};
+use mocap_core::{Error, Result};
+
+/// Each sensor's frames in time order (duplicates removed).
+#[derive(Debug, Clone, Default)]
+pub struct SensorStreams {
+    pub streams: BTreeMap<u16, Vec<SensorFrame>>,
+}
+
+impl SensorStreams {
+    pub fn new(frames: impl IntoIterator<Item = SensorFrame>) -> SensorStreams {
+        let mut streams: BTreeMap<u16, Vec<SensorFrame>> = BTreeMap::new();
+        for f in frames {
+            streams.entry(f.sensor).or_default().push(f);
+        }
+        for s in streams.values_mut() {
+            s.sort_by(|a, b| a.timestamp.total_cmp(&b.timestamp).then(a.seq.cmp(&b.seq)));
+            s.dedup_by(|a, b| a.seq == b.seq && a.timestamp == b.timestamp);
+        }
+        SensorStreams { streams }
+    }
+
+    /// First and last timestamp over all sensors.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        let first = self
+            .streams
+            .values()
+            .filter_map(|s| s.first())
+            .map(|f| f.timestamp)
+            .min_by(f64::total_cmp)?;
+        let last = self
+            .streams
+            .values()
+            .filter_map(|s| s.last())
+            .map(|f| f.timestamp)
+            .max_by(f64::total_cmp)?;
+        Some((first, last))
+    }
+}
+
+/// A sensor's skeleton at instant `t` (camera space), interpolated between
+/// its frames; `None` when it has no frame close enough.
+pub fn sample_stream(
+    frames: &[SensorFrame],
+    t: f64,
+    period: f64,
+) -> Option<[JointObservation; JOINT_COUNT]> {
+    let max_gap = 2.5 * period;
+    let i = frames.partition_point(|f| f.timestamp <= t);
+    let before = i.checked_sub(1).map(|k| &frames[k]);
+    let after = frames.get(i);
+    match (before, after) {
+        (Some(a), Some(b)) if b.timestamp - a.timestamp <= max_gap => {
+            let span = b.timestamp - a.timestamp;
+            let w = if span > 0.0 {
+                ((t - a.timestamp) / span) as f32
+            } else {
+                0.0
+            };
+            Some(std::array::from_fn(|n| JointObservation {
+                position: a.joints[n].position.lerp(b.joints[n].position, w),
+                state: a.joints[n].state.min(b.joints[n].state),
+            }))
+        }
+        (a, b) => [a, b]
+            .into_iter()
+            .flatten()
+            .filter(|f| (f.timestamp - t).abs() <= 0.5 * period + 1e-9)
+            .min_by(|x, y| (x.timestamp - t).abs().total_cmp(&(y.timestamp - t).abs()))
+            .map(|f| f.joints),
+    }
+}
+
+/// Every sensor's view of instant `t`, in world space.
+pub fn views_at(
+    streams: &SensorStreams,
+    calibration: &Calibration,
+    t: f64,
+    period: f64,
+) -> Vec<SensorView> {
+    streams
+        .streams
+        .iter()
+        .filter_map(|(&sensor, frames)| {
+            let pose = calibration.get(sensor)?;
+            let joints = sample_stream(frames, t, period)?;
+            Some(SensorView {
+                sensor,
+                joints: joints.map(|j| JointObservation {
+                    position: pose.apply(j.position),
+                    state: j.state,
+                }),
+            })
+        })
+        .collect()
+}
+
+/// Checks that every sensor in the recordings is calibrated.
+pub fn check_calibrated(streams: &SensorStreams, calibration: &Calibration) -> Result<()> {
+    let missing: Vec<String> = streams
+        .streams
+        .keys()
+        .filter(|s| calibration.get(**s).is_none())
+        .map(|s| s.to_string())
+        .collect();
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::Invalid(format!(
+            "the calibration has no pose for sensor(s) {}; calibrate them first (mocap fuse calibrate)",
+            missing.join(", ")
+        )))
+    }
+}
+
+/// Fuses recordings on a grid of `fps` instants from the first timestamp
+/// (or from `start` when given) to the last.
+pub fn fuse_streams(
+    streams: &SensorStreams,
+    calibration: &Calibration,
+    fuser: &mut Fuser,
+    fps: f64,
+    start: Option<f64>,
+) -> Vec<FusedFrame> {
+    let Some((first, last)) = streams.span() else {
+        return Vec::new();
+    };
+    let period = 1.0 / fps;
+    let t0 = start.unwrap_or(first);
+    let count = ((last - t0) * fps).floor().max(-1.0) as i64 + 1;
+    let mut out = Vec::with_capacity(count.max(0) as usize);
+    for i in 0..count {
+        let t = t0 + i as f64 * period;
+        let views = views_at(streams, calibration, t, period);
+        if let Some(f) = fuser.fuse(t, &views) {
+            out.push(f);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinect::TrackingState;
+    use mocap_core::rotation::Vec3;
+
+    fn frame(seq: u64, t: f64, x: f32, state: TrackingState) -> SensorFrame {
+        SensorFrame {
+            sensor: 0,
+            seq,
+            timestamp: t,
+            arrival: None,
+            joints: [JointObservation {
+                position: Vec3::new(x, 0.0, 2.0),
+                state,
+            }; JOINT_COUNT],
+        }
+    }
+
+    #[test]
+    fn streams_are_interpolated_and_gaps_respected() {
+        let p = 1.0 / 30.0;
+        let frames = vec![
+            frame(0, 0.0, 0.0, TrackingState::Tracked),
+            frame(1, p, 1.0, TrackingState::Inferred),
+            frame(5, 5.0 * p, 5.0, TrackingState::Tracked),
+        ];
+        let s = sample_stream(&frames, 0.5 * p, p).unwrap();
+        assert!((s[0].position.x - 0.5).abs() < 1e-5);
+        assert_eq!(s[0].state, TrackingState::Inferred, "worse of the two");
+        // In the 4-period gap: only near its ends.
+        assert!(sample_stream(&frames, 3.0 * p, p).is_none());
+        let near = sample_stream(&frames, 1.3 * p, p).unwrap();
+        assert_eq!(near[0].position.x, 1.0);
+        assert!(sample_stream(&frames, 7.0 * p, p).is_none());
+    }
+
+    #[test]
+    fn duplicates_and_disorder_are_cleaned() {
+        let p = 1.0 / 30.0;
+        let s = SensorStreams::new(vec![
+            frame(2, 2.0 * p, 2.0, TrackingState::Tracked),
+            frame(0, 0.0, 0.0, TrackingState::Tracked),
+            frame(2, 2.0 * p, 2.0, TrackingState::Tracked),
+        ]);
+        let v = &s.streams[&0];
+        assert_eq!(v.iter().map(|f| f.seq).collect::<Vec<_>>(), vec![0, 2]);
+    }
+}
