@@ -24,6 +24,10 @@
 //! | ankle | ankle | `Foot_L` | `LeftFoot` | `lfoot` | `AnkleLeft` |
 //! | toe | ball of the foot (toe joint) | `Toes_L` | `LeftToeBase` | `ltoes` | `FootLeft` |
 //!
+//! Biovision's own sample rig is known too (`Hips`, `Chest`, `Chest2`,
+//! `LeftCollar` = clavicle, `LeftShoulder` = shoulder point, `LeftElbow`,
+//! `LeftWrist`, `LeftHip`, `LeftKnee`, `LeftAnkle`).
+//!
 //! (ASF joints sit where their bone starts, so `lhumerus` is the shoulder
 //! point and `lradius` the elbow.) In CMU-style BVH files the `Neck` joint has
 //! a zero offset from `Spine1`, so it sits at the chest; `Neck1` is the base
@@ -284,8 +288,28 @@ const KINECT: Rig = Rig {
     ],
 };
 
+/// Biovision's own sample files and early MotionBuilder exports
+/// (`LeftCollar` is the clavicle, `LeftShoulder` the shoulder point).
+const BIOVISION: Rig = Rig {
+    name: "Biovision BVH",
+    parts: &[
+        (BodyPart::Pelvis, &["Hips"]),
+        (BodyPart::Spine, &["Chest"]),
+        (BodyPart::Chest, &["Chest2", "Chest"]),
+        (BodyPart::Neck, &["Neck"]),
+        (BodyPart::Head, &["Head"]),
+        (BodyPart::LeftShoulder, &["LeftShoulder"]),
+        (BodyPart::LeftElbow, &["LeftElbow"]),
+        (BodyPart::LeftWrist, &["LeftWrist"]),
+        (BodyPart::LeftHip, &["LeftHip"]),
+        (BodyPart::LeftKnee, &["LeftKnee"]),
+        (BodyPart::LeftAnkle, &["LeftAnkle"]),
+        (BodyPart::LeftToe, &["LeftToe"]),
+    ],
+};
+
 /// The built-in rigs, tried in this order by [`BodyMap::detect`].
-const RIGS: [&Rig; 4] = [&BANDAI, &CMU_BVH, &ASF, &KINECT];
+const RIGS: [&Rig; 5] = [&BANDAI, &CMU_BVH, &ASF, &KINECT, &BIOVISION];
 
 /// The Kinect v2 skeleton in `JointType` order: each joint's name and the
 /// index of its parent, per the SDK's bone list. Kinect order is not
@@ -365,7 +389,8 @@ pub struct BodyMap {
 
 impl BodyMap {
     /// Finds the body parts of `skeleton` with the built-in rigs (Bandai
-    /// Namco, CMU-style BVH and Mixamo, CMU/HDM05 ASF, Kinect v2) and keeps
+    /// Namco, CMU-style BVH and Mixamo, CMU/HDM05 ASF, Kinect v2, Biovision)
+    /// and keeps
     /// the one that locates the most parts. Fails, naming the missing parts
     /// and the names tried, when no rig locates every required part
     /// ([`BodyPart::is_required`]).

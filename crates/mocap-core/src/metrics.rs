@@ -1,1 +1,252 @@
-//! (being written)
+//! The numbers every capability reports, computed in one place: joint
+//! position and rotation errors, acceleration error, jitter and bone-length
+//! statistics.
+//!
+//! Conventions:
+//! - Positions are compared as given (no root alignment, no Procrustes):
+//!   align them first if the comparison calls for it.
+//! - Lengths are in the units of the data (centimetres for Bandai).
+//! - Finite differences are taken per frame: an acceleration is in units per
+//!   frame², a jerk in units per frame³. Multiply by `fps²` (`fps³`) for
+//!   units per second² (second³).
+//! - Sums are accumulated in double precision.
+//! - Two inputs of different shapes (joint or frame counts) give an error,
+//!   never a panic or a silently truncated comparison.
+
+use crate::error::{Error, Result};
+use crate::kinematics::GlobalPoses;
+use crate::motion::Motion;
+use crate::rotation::{angle_between, Vec3};
+use crate::skeleton::Skeleton;
+
+/// Mean over frames of the distance between each joint's positions in `a`
+/// and `b` (one value per joint).
+pub fn joint_position_errors(a: &GlobalPoses, b: &GlobalPoses) -> Result<Vec<f32>> {
+    same_shape(a, b)?;
+    nonempty(a.frame_count, 1, "a position error")?;
+    let mut sums = vec![0.0f64; a.joint_count];
+    for (k, (pa, pb)) in a.positions.iter().zip(&b.positions).enumerate() {
+        sums[k % a.joint_count] += pa.distance(*pb) as f64;
+    }
+    Ok(sums
+        .into_iter()
+        .map(|s| (s / a.frame_count as f64) as f32)
+        .collect())
+}
+
+/// Mean per-joint position error (MPJPE): the distance between the
+/// positions of each joint in `a` and `b`, averaged over frames and over
+/// `joints` (all joints when `None`).
+pub fn mean_joint_position_error(
+    a: &GlobalPoses,
+    b: &GlobalPoses,
+    joints: Option<&[usize]>,
+) -> Result<f32> {
+    same_shape(a, b)?;
+    let joints = joint_selection(joints, a.joint_count)?;
+    nonempty(a.frame_count, 1, "a position error")?;
+    let mut sum = 0.0f64;
+    for f in 0..a.frame_count {
+        for &j in &joints {
+            sum += a.position(f, j).distance(b.position(f, j)) as f64;
+        }
+    }
+    Ok((sum / (a.frame_count * joints.len()) as f64) as f32)
+}
+
+/// Mean over frames of the geodesic angle in degrees between each joint's
+/// local rotations in `a` and `b` ([`angle_between`]; one value per joint,
+/// 0 for a joint without rotation channels in either motion).
+pub fn joint_rotation_errors_degrees(a: &Motion, b: &Motion) -> Result<Vec<f32>> {
+    same_motion_shape(a, b)?;
+    nonempty(a.frame_count(), 1, "a rotation error")?;
+    let n = a.skeleton().joint_count();
+    let mut out = Vec::with_capacity(n);
+    for j in 0..n {
+        let mut sum = 0.0f64;
+        if rotates(a, b, j) {
+            for f in 0..a.frame_count() {
+                sum += angle_between(a.local_rotation(f, j), b.local_rotation(f, j)) as f64;
+            }
+        }
+        out.push((sum / a.frame_count() as f64).to_degrees() as f32);
+    }
+    Ok(out)
+}
+
+/// Mean geodesic angle in degrees between the local rotations of `a` and
+/// `b`, over frames and over the joints that have rotation channels in
+/// either motion.
+pub fn mean_rotation_error_degrees(a: &Motion, b: &Motion) -> Result<f32> {
+    let per_joint = joint_rotation_errors_degrees(a, b)?;
+    let rotating: Vec<f32> = per_joint
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| rotates(a, b, j))
+        .map(|(_, &e)| e)
+        .collect();
+    if rotating.is_empty() {
+        return Err(Error::Invalid(
+            "no joint has rotation channels: there is no rotation error to measure".to_string(),
+        ));
+    }
+    Ok((rotating.iter().map(|&e| e as f64).sum::<f64>() / rotating.len() as f64) as f32)
+}
+
+fn rotates(a: &Motion, b: &Motion, joint: usize) -> bool {
+    a.skeleton().joint(joint).has_rotation_channels()
+        || b.skeleton().joint(joint).has_rotation_channels()
+}
+
+/// Acceleration error: the mean over frames `1..n-1` and over `joints` of
+/// `|(a[t+1] - 2 a[t] + a[t-1]) - (b[t+1] - 2 b[t] + b[t-1])|`, the norm of
+/// the difference of the second finite differences of the positions, in
+/// units per frame² (as in the human-motion literature, e.g. Kanazawa et
+/// al., "Learning 3D Human Dynamics from Video", CVPR 2019). Needs at least
+/// three frames.
+pub fn acceleration_error(
+    a: &GlobalPoses,
+    b: &GlobalPoses,
+    joints: Option<&[usize]>,
+) -> Result<f32> {
+    same_shape(a, b)?;
+    let joints = joint_selection(joints, a.joint_count)?;
+    nonempty(a.frame_count, 3, "an acceleration")?;
+    let accel = |p: &GlobalPoses, f: usize, j: usize| {
+        p.position(f + 1, j) - 2.0 * p.position(f, j) + p.position(f - 1, j)
+    };
+    let mut sum = 0.0f64;
+    for f in 1..a.frame_count - 1 {
+        for &j in &joints {
+            sum += (accel(a, f, j) - accel(b, f, j)).length() as f64;
+        }
+    }
+    Ok((sum / ((a.frame_count - 2) * joints.len()) as f64) as f32)
+}
+
+/// Jitter: the mean norm of the third finite difference of the positions
+/// (the jerk, `p[t+2] - 3 p[t+1] + 3 p[t] - p[t-1]`) over frames and over
+/// `joints`, in units per frame³. The third difference is used rather than
+/// the second because it is near zero for smooth motion of any speed,
+/// while the second difference of a real take is dominated by its genuine
+/// accelerations. Needs at least four frames.
+pub fn jitter(poses: &GlobalPoses, joints: Option<&[usize]>) -> Result<f32> {
+    let joints = joint_selection(joints, poses.joint_count)?;
+    nonempty(poses.frame_count, 4, "a jerk")?;
+    let mut sum = 0.0f64;
+    for f in 1..poses.frame_count - 2 {
+        for &j in &joints {
+            let p = |k: usize| poses.position(k, j);
+            let jerk: Vec3 = p(f + 2) - 3.0 * p(f + 1) + 3.0 * p(f) - p(f - 1);
+            sum += jerk.length() as f64;
+        }
+    }
+    Ok((sum / ((poses.frame_count - 3) * joints.len()) as f64) as f32)
+}
+
+/// Length of one bone (joint to parent) over the frames of a take.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoneLengthStats {
+    /// The joint at the end of the bone.
+    pub joint: usize,
+    /// The joint at its start.
+    pub parent: usize,
+    pub mean: f32,
+    /// Population standard deviation (divides by the frame count).
+    pub std: f32,
+    pub min: f32,
+    pub max: f32,
+}
+
+/// Statistics of the length of every bone (each joint with a parent) over
+/// the frames of `poses`, in skeleton order. For a motion played by FK on a
+/// rigid skeleton the lengths are constant; positions from a tracker or a
+/// network show how far they stretch.
+pub fn bone_length_stats(poses: &GlobalPoses, skeleton: &Skeleton) -> Result<Vec<BoneLengthStats>> {
+    if poses.joint_count != skeleton.joint_count() {
+        return Err(Error::Invalid(format!(
+            "the poses have {} joints but the skeleton has {}",
+            poses.joint_count,
+            skeleton.joint_count()
+        )));
+    }
+    nonempty(poses.frame_count, 1, "a bone length")?;
+    let mut out = Vec::new();
+    for (j, joint) in skeleton.joints().iter().enumerate() {
+        let Some(parent) = joint.parent else { continue };
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        let (mut min, mut max) = (f32::INFINITY, f32::NEG_INFINITY);
+        for f in 0..poses.frame_count {
+            let length = poses.position(f, j).distance(poses.position(f, parent));
+            sum += length as f64;
+            sum_sq += (length as f64) * (length as f64);
+            min = min.min(length);
+            max = max.max(length);
+        }
+        let n = poses.frame_count as f64;
+        let mean = sum / n;
+        let variance = (sum_sq / n - mean * mean).max(0.0);
+        out.push(BoneLengthStats {
+            joint: j,
+            parent,
+            mean: mean as f32,
+            std: variance.sqrt() as f32,
+            min,
+            max,
+        });
+    }
+    Ok(out)
+}
+
+fn same_shape(a: &GlobalPoses, b: &GlobalPoses) -> Result<()> {
+    if a.joint_count != b.joint_count || a.frame_count != b.frame_count {
+        return Err(Error::Invalid(format!(
+            "cannot compare poses of different shapes: {} frames of {} joints against {} \
+             frames of {} joints",
+            a.frame_count, a.joint_count, b.frame_count, b.joint_count
+        )));
+    }
+    Ok(())
+}
+
+fn same_motion_shape(a: &Motion, b: &Motion) -> Result<()> {
+    let (ja, jb) = (a.skeleton().joint_count(), b.skeleton().joint_count());
+    if ja != jb || a.frame_count() != b.frame_count() {
+        return Err(Error::Invalid(format!(
+            "cannot compare motions of different shapes: {} frames of {ja} joints against {} \
+             frames of {jb} joints",
+            a.frame_count(),
+            b.frame_count()
+        )));
+    }
+    Ok(())
+}
+
+/// The joints to average over: all of them, or the given ones after
+/// checking they exist.
+fn joint_selection(joints: Option<&[usize]>, joint_count: usize) -> Result<Vec<usize>> {
+    match joints {
+        None => Ok((0..joint_count).collect()),
+        Some([]) => Err(Error::Invalid(
+            "the list of joints to measure is empty".to_string(),
+        )),
+        Some(list) => {
+            if let Some(&bad) = list.iter().find(|&&j| j >= joint_count) {
+                return Err(Error::Invalid(format!(
+                    "joint index {bad} is outside the poses ({joint_count} joints)"
+                )));
+            }
+            Ok(list.to_vec())
+        }
+    }
+}
+
+fn nonempty(frames: usize, needed: usize, what: &str) -> Result<()> {
+    if frames < needed {
+        return Err(Error::Invalid(format!(
+            "{what} needs at least {needed} frame{}, got {frames}",
+            if needed == 1 { "" } else { "s" }
+        )));
+    }
+    Ok(())
+}
