@@ -470,3 +470,160 @@ fn parts_mirror_and_keys_round_trip() {
     }
     assert_eq!(BodyPart::LeftShoulder.to_string(), "left shoulder");
 }
+
+// ---------------------------------------------------------------------------
+// Real rigs: the parts sit where their names say, checked on FK positions.
+
+use mocap_core::io::asf_amc::read_asf_amc;
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::{forward_kinematics, Motion};
+use std::path::{Path, PathBuf};
+
+/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
+fn shared_data() -> Option<PathBuf> {
+    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
+        Some(d) => PathBuf::from(d),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+    };
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
+            dir.display()
+        );
+        None
+    }
+}
+
+/// Checks, on the first frame of a take that starts standing, that the
+/// detected parts are at the anatomical points they stand for.
+fn check_anatomy(m: &Motion, rig: &str, what: &str) {
+    use BodyPart::*;
+    let s = m.skeleton();
+    let map = BodyMap::detect(s).unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert_eq!(map.rig(), rig, "{what}");
+    let p = forward_kinematics(m);
+    let at = |part: BodyPart| p.position(0, map.joint(part).unwrap());
+    let height = at(Head).y - at(LeftAnkle).y.min(at(RightAnkle).y);
+    let lateral = (at(LeftHip) - at(RightHip)).normalize();
+
+    // The spine goes up from the pelvis to the head (Y is up in all files).
+    let spine: Vec<BodyPart> = [Pelvis, Spine, Chest, Neck, Head]
+        .into_iter()
+        .filter(|&part| map.joint(part).is_some())
+        .collect();
+    for pair in spine.windows(2) {
+        assert!(
+            at(pair[0]).y < at(pair[1]).y,
+            "{what}: {} below {}",
+            pair[0],
+            pair[1]
+        );
+    }
+    for side in [
+        [LeftShoulder, LeftElbow, LeftWrist, LeftHand],
+        [RightShoulder, RightElbow, RightWrist, RightHand],
+        [LeftHip, LeftKnee, LeftAnkle, LeftToe],
+        [RightHip, RightKnee, RightAnkle, RightToe],
+    ] {
+        let chain: Vec<BodyPart> = side
+            .into_iter()
+            .filter(|&part| map.joint(part).is_some())
+            .collect();
+        for (k, pair) in chain.windows(2).enumerate() {
+            let (a, b) = (map.joint(pair[0]).unwrap(), map.joint(pair[1]).unwrap());
+            // Each part hangs below the previous one and is a distinct point:
+            // upper arm, forearm, thigh and shin are long bones, the hand
+            // and toe points lie a little beyond the wrist and ankle.
+            assert!(
+                s.subtree(a).contains(&b),
+                "{what}: {} under {}",
+                pair[1],
+                pair[0]
+            );
+            // The long bones join their two parts directly: the shoulder
+            // point is the elbow's parent (a clavicle joint would not be).
+            if k < 2 {
+                assert_eq!(
+                    s.joint(b).parent,
+                    Some(a),
+                    "{what}: {} to {}",
+                    pair[0],
+                    pair[1]
+                );
+            }
+            let length = at(pair[0]).distance(at(pair[1])) / height;
+            let shortest = if k < 2 { 0.1 } else { 0.02 };
+            assert!(
+                length > shortest,
+                "{what}: {} to {} is {length} of the height",
+                pair[0],
+                pair[1]
+            );
+        }
+        // Thigh and shin, upper arm and forearm are of similar length.
+        let ratio = at(chain[0]).distance(at(chain[1])) / at(chain[1]).distance(at(chain[2]));
+        assert!(
+            (0.6..1.7).contains(&ratio),
+            "{what}: {} segment ratio {ratio}",
+            chain[0]
+        );
+    }
+    // The left shoulder is on the left (limbs can cross in a pose, the
+    // shoulders cannot; the chains above check the rest hangs from them).
+    let across = (at(LeftShoulder) - at(RightShoulder)).dot(lateral);
+    assert!(across > 0.0, "{what}: left shoulder is not on the left");
+    // The shoulder and hip points are the ball joints, not the clavicle or
+    // pelvis joints they hang from: they are further apart than those.
+    for (left, right) in [(LeftShoulder, RightShoulder), (LeftHip, RightHip)] {
+        let (l, r) = (map.joint(left).unwrap(), map.joint(right).unwrap());
+        let (pl, pr) = (s.joint(l).parent.unwrap(), s.joint(r).parent.unwrap());
+        let width = at(left).distance(at(right));
+        let parent_width = p.position(0, pl).distance(p.position(0, pr));
+        assert!(
+            width > 1.5 * parent_width && width > 0.05 * height,
+            "{what}: {left} width {width}, parents {parent_width}"
+        );
+    }
+}
+
+#[test]
+fn real_rigs_put_parts_at_their_anatomical_points() {
+    let Some(data) = shared_data() else { return };
+    for (dataset, step) in [("dataset-1", 5), ("dataset-2", 40)] {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(data.join("bandai").join(dataset))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+            .collect();
+        files.sort();
+        for path in files.iter().step_by(step) {
+            let m = read_bvh(path).unwrap();
+            check_anatomy(&m, "Bandai Namco", &path.display().to_string());
+            assert_eq!(mirror_pairs(m.skeleton()).len(), 8);
+        }
+    }
+    let cases = data.join("parser-cases");
+    for (name, rig, pairs) in [
+        (
+            "dme_example_crlf_leadingdot_frametime.bvh",
+            "CMU-style BVH",
+            12,
+        ),
+        ("bvhpython_test_freebvh.bvh", "Mixamo", 24),
+        ("bvhanim_test_mocapbank.bvh", "Biovision BVH", 7),
+    ] {
+        let m = read_bvh(&cases.join(name)).unwrap();
+        check_anatomy(&m, rig, name);
+        assert_eq!(mirror_pairs(m.skeleton()).len(), pairs, "{name}");
+    }
+    let hdm = data.join("hdm05-sample");
+    let m = read_asf_amc(
+        hdm.join("HDM_bd.asf"),
+        hdm.join("HDM_bd_depositFloorR_001_120.amc"),
+    )
+    .unwrap();
+    check_anatomy(&m, "CMU/HDM05 ASF", "HDM_bd");
+    assert_eq!(mirror_pairs(m.skeleton()).len(), 12);
+}
