@@ -1,0 +1,329 @@
+//! Relative pose features: 56 numbers per frame that describe the pose in a
+//! body-centred frame, independent of where the performer stands, which way
+//! they face and how tall they are.
+//!
+//! **Body-centred frame.** Origin at the pelvis; up is the world up axis
+//! (+Y, the BVH and ASF/AMC convention); the lateral axis `x` points to the
+//! performer's left: the sum of the left-minus-right hip and
+//! left-minus-right shoulder vectors, projected on the floor; forward is
+//! `z = x × up`. A position `p` becomes `(x·(p - pelvis), up·(p - pelvis),
+//! z·(p - pelvis)) / h`.
+//!
+//! **Body height `h`.** The report takes `max(J_y) - min(J_y)` of the upright
+//! rest pose. Rest poses are not upright in every rig (Bandai's joints have
+//! rotated local frames, so its zero pose lies on its side), so `h` is the
+//! height the same joints span when standing straight: the length of the
+//! bone chain from the head down to the pelvis plus the mean length of the
+//! chains from the pelvis down to each ankle, measured on the first frame.
+//!
+//! **The 56 values** (positions and distances divided by `h`, velocities per
+//! second, angles in radians), numbered as in [`VALUE_NAMES`]:
+//!
+//! | values | what |
+//! | --- | --- |
+//! | 0-26 | head, left/right wrist, elbow, knee and ankle in the body frame (x, y, z each) |
+//! | 27 | pelvis height above the floor (the lowest ankle of the clip) |
+//! | 28-37 | distances: wrist-wrist, ankle-ankle, knee-knee, elbow-elbow, each wrist to the head, each wrist to the other shoulder, each wrist to its own hip |
+//! | 38-41 | flexion of the left/right elbow and knee (angle between the two bones) |
+//! | 42-44 | body tilt: angle between the body axis (pelvis to neck) and the body frame's up, forward and lateral axes |
+//! | 45-48 | pelvis velocity in the body frame (x, y, z) and turning speed about up (left turns positive) |
+//! | 49-52 | speed of each wrist and ankle relative to the body frame |
+//! | 53-55 | height of each wrist above the head, height of the left ankle above the right one |
+//!
+//! The velocities (45-52) carry what a single pose cannot: walking forward,
+//! backward, sideways or in a turn differ mostly in how the pelvis moves.
+
+use mocap_core::bodymap::{BodyMap, BodyPart};
+use mocap_core::rotation::Vec3;
+use mocap_core::{forward_kinematics, GlobalPoses, Motion};
+
+use crate::error::{Result, SearchError};
+use crate::intervals::FeatureSequence;
+
+/// Number of values per frame.
+pub const VALUE_COUNT: usize = 56;
+
+/// Version of the feature definition, stored in every index: change it when
+/// the values above change, so that old index files are reported stale.
+pub const FEATURE_VERSION: u32 = 1;
+
+/// Names of the 56 values, in order.
+pub const VALUE_NAMES: [&str; VALUE_COUNT] = [
+    "head.x",
+    "head.y",
+    "head.z",
+    "left_wrist.x",
+    "left_wrist.y",
+    "left_wrist.z",
+    "right_wrist.x",
+    "right_wrist.y",
+    "right_wrist.z",
+    "left_elbow.x",
+    "left_elbow.y",
+    "left_elbow.z",
+    "right_elbow.x",
+    "right_elbow.y",
+    "right_elbow.z",
+    "left_knee.x",
+    "left_knee.y",
+    "left_knee.z",
+    "right_knee.x",
+    "right_knee.y",
+    "right_knee.z",
+    "left_ankle.x",
+    "left_ankle.y",
+    "left_ankle.z",
+    "right_ankle.x",
+    "right_ankle.y",
+    "right_ankle.z",
+    "pelvis_height",
+    "wrist_wrist",
+    "ankle_ankle",
+    "knee_knee",
+    "elbow_elbow",
+    "left_wrist_head",
+    "right_wrist_head",
+    "left_wrist_right_shoulder",
+    "right_wrist_left_shoulder",
+    "left_wrist_left_hip",
+    "right_wrist_right_hip",
+    "left_elbow_flexion",
+    "right_elbow_flexion",
+    "left_knee_flexion",
+    "right_knee_flexion",
+    "tilt_up",
+    "tilt_forward",
+    "tilt_lateral",
+    "pelvis_velocity.x",
+    "pelvis_velocity.y",
+    "pelvis_velocity.z",
+    "turn_speed",
+    "left_wrist_speed",
+    "right_wrist_speed",
+    "left_ankle_speed",
+    "right_ankle_speed",
+    "left_wrist_above_head",
+    "right_wrist_above_head",
+    "left_ankle_above_right",
+];
+
+/// World up axis (BVH and ASF/AMC are Y-up).
+const UP: Vec3 = Vec3::Y;
+
+/// The joints the features are made of, as joint indices of one skeleton.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeyJoints {
+    pub pelvis: usize,
+    pub neck: usize,
+    pub head: usize,
+    /// Left then right for each of the following.
+    pub shoulder: [usize; 2],
+    pub elbow: [usize; 2],
+    pub wrist: [usize; 2],
+    pub hip: [usize; 2],
+    pub knee: [usize; 2],
+    pub ankle: [usize; 2],
+}
+
+impl KeyJoints {
+    /// Finds the key joints of a skeleton with the core body map; the error
+    /// names the body parts the rig lacks.
+    pub fn detect(skeleton: &mocap_core::Skeleton) -> Result<KeyJoints> {
+        let map = BodyMap::detect(skeleton)?;
+        let part = |p: BodyPart| -> Result<usize> { Ok(map.require(p)?) };
+        let pair = |l: BodyPart, r: BodyPart| -> Result<[usize; 2]> { Ok([part(l)?, part(r)?]) };
+        let head = part(BodyPart::Head)?;
+        // Not every rig has a neck joint (the body map does not require
+        // one): the chest or the head's parent stands in for the top of the
+        // body axis.
+        let neck = map
+            .joint(BodyPart::Neck)
+            .or(map.joint(BodyPart::Chest))
+            .or(skeleton.joint(head).parent)
+            .unwrap_or(head);
+        Ok(KeyJoints {
+            pelvis: part(BodyPart::Pelvis)?,
+            neck,
+            head,
+            shoulder: pair(BodyPart::LeftShoulder, BodyPart::RightShoulder)?,
+            elbow: pair(BodyPart::LeftElbow, BodyPart::RightElbow)?,
+            wrist: pair(BodyPart::LeftWrist, BodyPart::RightWrist)?,
+            hip: pair(BodyPart::LeftHip, BodyPart::RightHip)?,
+            knee: pair(BodyPart::LeftKnee, BodyPart::RightKnee)?,
+            ankle: pair(BodyPart::LeftAnkle, BodyPart::RightAnkle)?,
+        })
+    }
+}
+
+/// The per-frame features of a motion, at its own frame rate.
+pub fn motion_features(motion: &Motion) -> Result<FeatureSequence> {
+    let joints = KeyJoints::detect(motion.skeleton())?;
+    let poses = forward_kinematics(motion);
+    let parents: Vec<Option<usize>> = motion
+        .skeleton()
+        .joints()
+        .iter()
+        .map(|j| j.parent)
+        .collect();
+    pose_features(&poses, &joints, &parents, motion.fps())
+}
+
+/// Body height `h` (see the module docs) from the first frame.
+pub fn body_height(poses: &GlobalPoses, joints: &KeyJoints, parents: &[Option<usize>]) -> f32 {
+    // Length of the bone chain from `from` up to its ancestor `to`.
+    let chain = |from: usize, to: usize| -> f32 {
+        let mut length = 0.0;
+        let mut at = from;
+        while at != to {
+            let Some(parent) = parents[at] else { break };
+            length += poses.position(0, at).distance(poses.position(0, parent));
+            at = parent;
+        }
+        length
+    };
+    let legs =
+        (chain(joints.ankle[0], joints.pelvis) + chain(joints.ankle[1], joints.pelvis)) / 2.0;
+    chain(joints.head, joints.pelvis) + legs
+}
+
+/// Angle in radians between two vectors (0 when either is zero).
+fn angle(a: Vec3, b: Vec3) -> f32 {
+    let n = a.length() * b.length();
+    if n < 1e-12 {
+        return 0.0;
+    }
+    (a.dot(b) / n).clamp(-1.0, 1.0).acos()
+}
+
+/// The unit lateral (left) axis of every frame's body-centred frame. Where
+/// hips and shoulders give no horizontal direction (lying down), the
+/// previous frame's axis is kept.
+fn lateral_axes(poses: &GlobalPoses, j: &KeyJoints) -> Vec<Vec3> {
+    let mut axes = Vec::with_capacity(poses.frame_count);
+    let mut last = Vec3::X;
+    for f in 0..poses.frame_count {
+        let p = |joint: usize| poses.position(f, joint);
+        let across = (p(j.hip[0]) - p(j.hip[1])) + (p(j.shoulder[0]) - p(j.shoulder[1]));
+        let flat = across - UP * across.dot(UP);
+        if flat.length() > 1e-6 {
+            last = flat.normalize();
+        }
+        axes.push(last);
+    }
+    axes
+}
+
+/// Signed angle in radians turning `a` into `b` about the up axis
+/// (counter-clockwise seen from above, i.e. a left turn, is positive).
+fn turn_angle(a: Vec3, b: Vec3) -> f32 {
+    a.cross(b).dot(UP).atan2(a.dot(b))
+}
+
+/// The frames before and after `f` for a central difference, and the time
+/// between them in frames (one-sided at the ends of the clip).
+fn neighbours(f: usize, frames: usize) -> (usize, usize, f32) {
+    let before = f.saturating_sub(1);
+    let after = (f + 1).min(frames - 1);
+    (before, after, (after - before).max(1) as f32)
+}
+
+/// The 56 values of every frame of `poses` (see the module docs).
+/// `parents` gives each joint's parent (for the body height) and `fps`
+/// turns frame differences into velocities per second.
+pub fn pose_features(
+    poses: &GlobalPoses,
+    j: &KeyJoints,
+    parents: &[Option<usize>],
+    fps: f64,
+) -> Result<FeatureSequence> {
+    let frames = poses.frame_count;
+    if frames == 0 {
+        return Err(SearchError::Invalid("the motion has no frames".into()));
+    }
+    let h = body_height(poses, j, parents);
+    if !(h.is_finite() && h > 1e-6) {
+        return Err(SearchError::Invalid(format!(
+            "the body height from head to ankles is {h}; the skeleton's key joints coincide"
+        )));
+    }
+    let fps = fps as f32;
+    let lateral = lateral_axes(poses, j);
+    let floor = (0..frames)
+        .flat_map(|f| j.ankle.map(|a| poses.position(f, a).dot(UP)))
+        .fold(f32::INFINITY, f32::min);
+    // Body-frame coordinates of joint `joint` in frame `f`, over h.
+    let body = |f: usize, joint: usize| -> Vec3 {
+        let x = lateral[f];
+        let z = x.cross(UP);
+        let d = (poses.position(f, joint) - poses.position(f, j.pelvis)) / h;
+        Vec3::new(d.dot(x), d.dot(UP), d.dot(z))
+    };
+    let mut values = Vec::with_capacity(frames * VALUE_COUNT);
+    for f in 0..frames {
+        let start = values.len();
+        let p = |joint: usize| poses.position(f, joint);
+        let dist = |a: usize, b: usize| p(a).distance(p(b)) / h;
+        // 0-26: key joints in the body frame.
+        for joint in [
+            j.head, j.wrist[0], j.wrist[1], j.elbow[0], j.elbow[1], j.knee[0], j.knee[1],
+            j.ankle[0], j.ankle[1],
+        ] {
+            values.extend_from_slice(&body(f, joint).to_array());
+        }
+        // 27: pelvis above the floor.
+        values.push((p(j.pelvis).dot(UP) - floor) / h);
+        // 28-37: distances between joints.
+        values.extend_from_slice(&[
+            dist(j.wrist[0], j.wrist[1]),
+            dist(j.ankle[0], j.ankle[1]),
+            dist(j.knee[0], j.knee[1]),
+            dist(j.elbow[0], j.elbow[1]),
+            dist(j.wrist[0], j.head),
+            dist(j.wrist[1], j.head),
+            dist(j.wrist[0], j.shoulder[1]),
+            dist(j.wrist[1], j.shoulder[0]),
+            dist(j.wrist[0], j.hip[0]),
+            dist(j.wrist[1], j.hip[1]),
+        ]);
+        // 38-41: flexion of elbows and knees (0 = straight).
+        let flexion = |a: usize, b: usize, c: usize| angle(p(b) - p(a), p(c) - p(b));
+        values.extend_from_slice(&[
+            flexion(j.shoulder[0], j.elbow[0], j.wrist[0]),
+            flexion(j.shoulder[1], j.elbow[1], j.wrist[1]),
+            flexion(j.hip[0], j.knee[0], j.ankle[0]),
+            flexion(j.hip[1], j.knee[1], j.ankle[1]),
+        ]);
+        // 42-44: body tilt against the body frame's axes.
+        let (x, z) = (lateral[f], lateral[f].cross(UP));
+        let axis = p(j.neck) - p(j.pelvis);
+        values.extend_from_slice(&[angle(axis, UP), angle(axis, z), angle(axis, x)]);
+        // 45-48: pelvis velocity in this frame's body frame, turning speed.
+        let (before, after, span) = neighbours(f, frames);
+        let rate = fps / span;
+        let v = (poses.position(after, j.pelvis) - poses.position(before, j.pelvis)) * rate / h;
+        values.extend_from_slice(&[v.dot(x), v.dot(UP), v.dot(z)]);
+        values.push(turn_angle(lateral[before], lateral[after]) * rate);
+        // 49-52: limb speeds relative to the body.
+        for joint in [j.wrist[0], j.wrist[1], j.ankle[0], j.ankle[1]] {
+            values.push((body(after, joint) - body(before, joint)).length() * rate);
+        }
+        // 53-55: heights.
+        let height = |joint: usize| p(joint).dot(UP) / h;
+        values.extend_from_slice(&[
+            height(j.wrist[0]) - height(j.head),
+            height(j.wrist[1]) - height(j.head),
+            height(j.ankle[0]) - height(j.ankle[1]),
+        ]);
+        debug_assert_eq!(values.len() - start, VALUE_COUNT);
+        if let Some(k) = values[start..].iter().position(|v| !v.is_finite()) {
+            return Err(SearchError::Invalid(format!(
+                "frame {f}: feature `{}` is not a finite number (joint positions are NaN or infinite)",
+                VALUE_NAMES[k]
+            )));
+        }
+    }
+    Ok(FeatureSequence {
+        dim: VALUE_COUNT,
+        values,
+    })
+}
