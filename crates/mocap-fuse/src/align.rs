@@ -412,6 +412,33 @@ pub fn calibrate_from_body(
                 src.len()
             )));
         }
+        // Which way the feet point in both sensors, frame by frame: a cue
+        // that does not depend on the left/right labels. A body seen from
+        // the front by one sensor and from behind by the other fits almost
+        // as well turned by 180 degrees with left and right swapped; the feet
+        // tell the two apart, so hypotheses that turn the feet backwards are
+        // refused.
+        let feet = |j: &[crate::recording::JointObservation; JOINT_COUNT]| -> Vec3 {
+            use crate::kinect::joint::*;
+            [(ANKLE_LEFT, FOOT_LEFT), (ANKLE_RIGHT, FOOT_RIGHT)]
+                .iter()
+                .filter(|(a, f)| tracked(&j[*a]) && tracked(&j[*f]))
+                .map(|(a, f)| j[*f].position - j[*a].position)
+                .sum()
+        };
+        let feet_pairs: Vec<(Vec3, Vec3)> = frame_pairs
+            .iter()
+            .map(|(a, b)| (feet(a), feet(b)))
+            .filter(|(a, b)| *a != Vec3::ZERO && *b != Vec3::ZERO)
+            .collect();
+        let feet_agree = |t: &RigidTransform| -> bool {
+            feet_pairs.is_empty()
+                || feet_pairs
+                    .iter()
+                    .map(|(a, b)| (t.rotation * *a).dot(*b))
+                    .sum::<f32>()
+                    > 0.0
+        };
         // RANSAC.
         let inlier2 = options.inlier_distance * options.inlier_distance;
         let mut best: Option<(usize, RigidTransform)> = None;
@@ -427,7 +454,7 @@ pub fn calibrate_from_body(
                 .zip(&dst)
                 .filter(|(p, q)| a.transform.apply(**p).distance_squared(**q) < inlier2)
                 .count();
-            if best.as_ref().is_none_or(|b| count > b.0) {
+            if best.as_ref().is_none_or(|b| count > b.0) && feet_agree(&a.transform) {
                 best = Some((count, a.transform));
             }
         }

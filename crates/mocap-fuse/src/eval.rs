@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use crate::body::{BodyModel, MeasureOptions};
 use crate::calib::Calibration;
 use crate::confidence::BoneLengthFunction;
-use crate::fusion::{Fuser, FusionOptions};
+use crate::fusion::{Fuser, FusionOptions, OneEuroParams};
 use crate::kinect::{joint::*, JOINT_COUNT};
 use crate::offline::{fuse_streams, views_at, SensorStreams};
 use crate::sim::{center_truth, simulate, truth_from_motion, GroundTruth, SimulationOptions};
@@ -98,55 +98,73 @@ pub struct EvalReport {
 
 /// The methods compared, in table order. `None` is the best single sensor.
 pub fn methods() -> Vec<(String, Option<FusionOptions>)> {
-    let gaussian = BoneLengthFunction::Gaussian { sigma: 0.04 };
-    let mut rom = FusionOptions::report();
-    rom.confidence.bone_length = Some(gaussian);
-    let mut swap = rom;
-    swap.swap_repair = true;
-    let mut robust = swap;
-    robust.robust_scale = Some(0.08);
+    let with = |f: &dyn Fn(&mut FusionOptions)| {
+        let mut o = FusionOptions::state_only();
+        f(&mut o);
+        Some(o)
+    };
+    let gaussian4 = BoneLengthFunction::Gaussian { sigma: 0.04 };
+    let gaussian8 = BoneLengthFunction::Gaussian { sigma: 0.08 };
     vec![
         ("best single sensor".into(), None),
-        (
-            "state only (report baseline)".into(),
-            Some(FusionOptions::state_only()),
-        ),
+        ("state only (report baseline)".into(), with(&|_| {})),
         (
             "+ bone length, linear 1-5d".into(),
-            Some(FusionOptions::bone_length(BoneLengthFunction::Linear {
-                a: 5.0,
-            })),
+            with(&|o| o.confidence.bone_length = Some(BoneLengthFunction::Linear { a: 5.0 })),
         ),
         (
             "+ bone length, inverse 1/(1+20d)".into(),
-            Some(FusionOptions::bone_length(BoneLengthFunction::Inverse {
-                a: 20.0,
-            })),
+            with(&|o| o.confidence.bone_length = Some(BoneLengthFunction::Inverse { a: 20.0 })),
         ),
         (
-            "+ bone length, gaussian 4 cm".into(),
-            Some(FusionOptions::bone_length(gaussian)),
+            "+ bone length, gaussian 4 cm (report method)".into(),
+            with(&|o| o.confidence.bone_length = Some(gaussian4)),
         ),
-        ("+ range of motion".into(), Some(rom)),
+        (
+            "+ range of motion (report, all terms)".into(),
+            with(&|o| {
+                o.confidence.bone_length = Some(gaussian4);
+                o.confidence.range_of_motion = Some(Default::default());
+            }),
+        ),
+        (
+            "bone length gaussian 8 cm, not propagated".into(),
+            with(&|o| {
+                o.confidence.bone_length = Some(gaussian8);
+                o.confidence.propagate = false;
+            }),
+        ),
         (
             "state only + swap repair".into(),
-            Some(FusionOptions {
-                swap_repair: true,
-                ..FusionOptions::state_only()
+            with(&|o| o.swap_repair = true),
+        ),
+        (
+            "report (all terms) + swap repair".into(),
+            with(&|o| {
+                o.confidence.bone_length = Some(gaussian4);
+                o.confidence.range_of_motion = Some(Default::default());
+                o.swap_repair = true;
             }),
         ),
         (
-            "bone length (gaussian) + swap repair".into(),
-            Some(FusionOptions {
-                swap_repair: true,
-                ..FusionOptions::bone_length(gaussian)
+            "swap repair + bone 8 cm unpropagated + ROM".into(),
+            with(&|o| {
+                o.confidence.bone_length = Some(gaussian8);
+                o.confidence.propagate = false;
+                o.confidence.range_of_motion = Some(Default::default());
+                o.swap_repair = true;
             }),
         ),
-        ("+ range of motion + swap repair".into(), Some(swap)),
-        ("+ robust reweighting".into(), Some(robust)),
         (
-            "best: + One Euro filter".into(),
+            "best: + robust reweighting (c = 25 cm)".into(),
             Some(FusionOptions::best()),
+        ),
+        (
+            "best + One Euro filter".into(),
+            Some(FusionOptions {
+                smoothing: Some(OneEuroParams::default()),
+                ..FusionOptions::best()
+            }),
         ),
     ]
 }
@@ -456,10 +474,10 @@ pub fn report_markdown(report: &EvalReport, command: &str) -> String {
             get("best single"),
             get("best:"),
             get("state only"),
-            get("+ bone length, gaussian"),
+            get("+ bone length, gaussian 4 cm"),
         ) {
             s += &format!(
-                "- {k} sensors: best version / best single sensor = {:.0}%; bone length (gaussian) vs state only: {:.1} vs {:.1} mm\n",
+                "- {k} sensors: best version / best single sensor = {:.0}% of its MPJPE; report's bone-length method vs state only: {:.1} vs {:.1} mm MPJPE\n",
                 100.0 * best / single,
                 bone,
                 state

@@ -90,14 +90,23 @@ impl FusionOptions {
         }
     }
 
-    /// Our best version: the report's terms plus swap repair, robust
-    /// reweighting and One Euro filtering.
+    /// Our best version: state weights, a wider bone-length term applied to
+    /// each joint alone (not propagated: the evaluation shows propagation
+    /// turns ordinary noise into frame-to-frame weight swings), the
+    /// range-of-motion term, swap repair and robust reweighting of gross
+    /// outliers. No temporal filter: the One Euro filter lowers jitter but
+    /// its lag raises the position error (see `bench/results/fuse.md`);
+    /// switch it on with `smoothing` when jitter matters more.
     pub fn best() -> FusionOptions {
         FusionOptions {
-            confidence: ConfidenceModel::default(),
+            confidence: ConfidenceModel {
+                bone_length: Some(crate::confidence::BoneLengthFunction::Gaussian { sigma: 0.08 }),
+                propagate: false,
+                ..ConfidenceModel::default()
+            },
             swap_repair: true,
-            robust_scale: Some(0.08),
-            smoothing: Some(OneEuroParams::default()),
+            robust_scale: Some(0.25),
+            smoothing: None,
         }
     }
 }

@@ -27,6 +27,7 @@ pub mod confidence;
 pub mod eval;
 pub mod fusion;
 pub mod kinect;
+pub mod net;
 pub mod offline;
 pub mod recording;
 pub mod sim;
