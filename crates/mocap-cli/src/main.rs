@@ -1,1 +1,52 @@
-fn main() {}
+//! `mocap`: the command-line front end. It parses arguments and calls the
+//! libraries; all the work happens in the `mocap-*` crates.
+//!
+//! Exit codes (scripts can rely on them):
+//! - 0: success;
+//! - 1: the input could not be used (a file missing, unreadable or malformed,
+//!   a request that does not fit the data);
+//! - 2: the command line itself is wrong (clap's usage errors).
+
+mod commands;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Human motion capture toolkit: read, convert, fuse, clean, search and restyle motion.
+#[derive(Parser)]
+#[command(name = "mocap", version, about, long_about = None)]
+struct Cli {
+    /// Print nothing but results and errors (no progress bars, no notes).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Joints, channels, frames, frame rate, duration and bounding box of motion files.
+    Info(commands::info::Args),
+    /// Convert, trim, resample, mirror or rescale a motion and write it as BVH.
+    Convert(commands::convert::Args),
+    /// Global joint positions of every frame, as CSV or JSON.
+    Positions(commands::positions::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let options = commands::GlobalOptions { quiet: cli.quiet };
+    let result = match cli.command {
+        Command::Info(args) => commands::info::run(args, &options),
+        Command::Convert(args) => commands::convert::run(args, &options),
+        Command::Positions(args) => commands::positions::run(args, &options),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -34,11 +34,12 @@ pub struct ParseError {
 pub enum Error {
     #[error(transparent)]
     Parse(#[from] ParseError),
-    #[error("{path}: {source}")]
+    // The I/O error is part of the message rather than a `source`, so that
+    // printing the error chain does not repeat it.
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A request that does not fit the data (a joint that does not exist, a
     /// frame range outside the take, a body part the rig lacks...).
@@ -47,10 +48,10 @@ pub enum Error {
 }
 
 impl Error {
-    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+    pub fn io(path: impl Into<PathBuf>, error: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
-            source,
+            error,
         }
     }
 }

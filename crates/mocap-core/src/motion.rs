@@ -170,41 +170,73 @@ impl Motion {
     /// and only the listed angles are kept. A joint without rotation channels
     /// is left unchanged.
     pub fn set_local_rotation(&mut self, frame: usize, joint: usize, rotation: Quat) {
-        let j = self.skeleton.joint(joint);
-        let listed: Vec<(usize, Axis)> = j
-            .channels
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| c.is_rotation())
-            .map(|(k, c)| (k, c.axis()))
-            .collect();
-        if listed.is_empty() {
+        let reference = (frame > 0).then(|| self.rotation_angles(frame - 1, joint));
+        self.set_local_rotation_near(frame, joint, rotation, reference);
+    }
+
+    /// Like [`Motion::set_local_rotation`], but the Euler angles are chosen
+    /// nearest to `reference` (radians, in the joint's rotation channel order;
+    /// `None` means zero), e.g. the angles of the same frame before an edit.
+    pub fn set_local_rotation_near(
+        &mut self,
+        frame: usize,
+        joint: usize,
+        rotation: Quat,
+        reference: Option<Vec3>,
+    ) {
+        let Some((columns, order)) = self.rotation_columns(joint) else {
             return;
-        }
-        let mut axes: Vec<Axis> = listed.iter().map(|&(_, a)| a).collect();
-        for a in [Axis::X, Axis::Y, Axis::Z] {
-            if !axes.contains(&a) {
-                axes.push(a);
-            }
-        }
-        let order = EulerOrder::from_axes([axes[0], axes[1], axes[2]])
-            .expect("three distinct axes form an Euler order");
-        let start = self.skeleton.channel_start(joint);
-        let previous = if frame > 0 {
-            let prev = self.frame(frame - 1);
-            let mut p = Vec3::ZERO;
-            for (slot, &(k, _)) in listed.iter().enumerate() {
-                p[slot] = prev[start + k] * DEG;
-            }
-            p
-        } else {
-            Vec3::ZERO
         };
-        let angles = quat_to_euler_near(order, rotation, previous);
+        let angles = quat_to_euler_near(order, rotation, reference.unwrap_or(Vec3::ZERO));
         let values = self.frame_mut(frame);
-        for (slot, &(k, _)) in listed.iter().enumerate() {
-            values[start + k] = angles[slot] / DEG;
+        for (slot, column) in columns.into_iter().enumerate() {
+            if let Some(c) = column {
+                values[c] = angles[slot] / DEG;
+            }
         }
+    }
+
+    /// The rotation channel values of `joint` in `frame`, in radians, in the
+    /// order of its rotation channels (missing channels are zero).
+    pub fn rotation_angles(&self, frame: usize, joint: usize) -> Vec3 {
+        let mut angles = Vec3::ZERO;
+        if let Some((columns, _)) = self.rotation_columns(joint) {
+            let values = self.frame(frame);
+            for (slot, column) in columns.into_iter().enumerate() {
+                if let Some(c) = column {
+                    angles[slot] = values[c] * DEG;
+                }
+            }
+        }
+        angles
+    }
+
+    /// Columns of the joint's rotation channels in frame order, and the Euler
+    /// order they form, with axes the joint lacks appended last (their
+    /// column is `None`). `None` for a joint without rotation channels.
+    fn rotation_columns(&self, joint: usize) -> Option<([Option<usize>; 3], EulerOrder)> {
+        let start = self.skeleton.channel_start(joint);
+        let mut columns = [None; 3];
+        let mut axes = [Axis::X; 3];
+        let mut count = 0;
+        for (k, c) in self.skeleton.joint(joint).channels.iter().enumerate() {
+            if c.is_rotation() && count < 3 {
+                columns[count] = Some(start + k);
+                axes[count] = c.axis();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return None;
+        }
+        for a in [Axis::X, Axis::Y, Axis::Z] {
+            if count < 3 && !axes[..count].contains(&a) {
+                axes[count] = a;
+                count += 1;
+            }
+        }
+        let order = EulerOrder::from_axes(axes).expect("three distinct axes form an Euler order");
+        Some((columns, order))
     }
 
     /// Sets the position channels of `joint` in `frame`. A joint without

@@ -178,6 +178,22 @@ fn non_numeric_value() {
 }
 
 #[test]
+fn non_finite_value() {
+    assert_error(
+        &with_line(19, Some("0 90 0 0 nan 0 1 2 3")),
+        19,
+        10,
+        "expected a number, found \"nan\"",
+    );
+    assert_error(
+        &with_line(19, Some("0 90 0 0 0 -inf 1 2 3")),
+        19,
+        12,
+        "expected a number, found \"-inf\"",
+    );
+}
+
+#[test]
 fn non_numeric_offset() {
     let text = with_line(8, Some("    OFFSET 0 ten 0"));
     assert_error(&text, 8, 14, "expected a number for OFFSET");

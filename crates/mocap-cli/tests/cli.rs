@@ -1,0 +1,171 @@
+//! The `mocap` command as a user runs it: outputs, exit codes and messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use mocap_core::io::asf_amc::read_asf_amc;
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::{forward_kinematics, metrics};
+
+fn mocap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args(args)
+        .output()
+        .expect("the mocap binary runs")
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn sample() -> String {
+    repo()
+        .join("samples/dataset-1_walk_normal_001.bvh")
+        .display()
+        .to_string()
+}
+
+fn shared_data() -> Option<PathBuf> {
+    let dir = std::env::var_os("MOCAP_SHARED_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("../shared/data"));
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("note: {} not found, skipping", dir.display());
+        None
+    }
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn info_json_reports_the_sample() {
+    let out = mocap(&["info", "--json", &sample()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let first = &info[0];
+    assert_eq!(first["frames"], 195);
+    assert_eq!(first["joints"], 22);
+    assert_eq!(first["channels"], 132);
+    assert_eq!(first["frame_time"], 0.0333333);
+    let hi_y = first["bounding_box"][1][1].as_f64().unwrap();
+    assert!((100.0..250.0).contains(&hi_y), "head height {hi_y} cm");
+}
+
+#[test]
+fn convert_trims_resamples_and_mirrors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("clip.bvh");
+    let out = mocap(&[
+        "convert",
+        &sample(),
+        "--frames",
+        "10..70",
+        "--fps",
+        "60",
+        "--mirror",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let clip = read_bvh(&out_path).unwrap();
+    let source = read_bvh(Path::new(&sample())).unwrap();
+    assert_eq!(
+        clip.skeleton().joint_count(),
+        source.skeleton().joint_count()
+    );
+    assert!((clip.fps() - 60.0).abs() < 1e-9);
+    // 60 frames at 30 fps span 59 intervals: 118 intervals at 60 fps.
+    assert_eq!(clip.frame_count(), 119);
+}
+
+#[test]
+fn positions_csv_has_a_row_per_frame() {
+    let out = mocap(&["positions", "--csv", &sample()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 195);
+    assert!(lines[0].starts_with("frame,time,joint_Root.x,joint_Root.y,joint_Root.z,Hips.x"));
+    assert_eq!(lines[1].split(',').count(), 2 + 22 * 3);
+}
+
+#[test]
+fn bad_input_exits_1_with_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.bvh");
+    std::fs::write(
+        &bad,
+        "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Wrotation\n}\n",
+    )
+    .unwrap();
+    let out = mocap(&["info", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = stderr(&out);
+    assert!(
+        message.contains("bad.bvh:5:") && message.contains("Wrotation"),
+        "{message}"
+    );
+    let missing = mocap(&["info", "no-such-file.bvh"]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(stderr(&missing).contains("no-such-file.bvh"));
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    assert_eq!(mocap(&["convert", &sample()]).status.code(), Some(1));
+    assert_eq!(mocap(&["info"]).status.code(), Some(2));
+    assert_eq!(mocap(&["no-such-command"]).status.code(), Some(2));
+    for sub in ["info", "convert", "positions"] {
+        let help = mocap(&[sub, "--help"]);
+        assert!(help.status.success());
+        assert!(!help.stdout.is_empty());
+    }
+}
+
+#[test]
+fn a_failed_convert_leaves_no_output_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("out.bvh");
+    let out = mocap(&[
+        "convert",
+        &sample(),
+        "--frames",
+        "10..5000",
+        out_path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("outside the take"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!out_path.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "temp files left"
+    );
+}
+
+#[test]
+fn asf_amc_converts_to_a_bvh_with_the_same_poses() {
+    let Some(data) = shared_data() else { return };
+    let asf = data.join("hdm05-sample/HDM_bd.asf");
+    let amc = data.join("hdm05-sample/HDM_bd_depositFloorR_001_120.amc");
+    let dir = tempfile::tempdir().unwrap();
+    let bvh = dir.path().join("deposit.bvh");
+    let out = mocap(&[
+        "convert",
+        asf.to_str().unwrap(),
+        amc.to_str().unwrap(),
+        bvh.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let original = forward_kinematics(&read_asf_amc(&asf, &amc).unwrap());
+    let converted = forward_kinematics(&read_bvh(&bvh).unwrap());
+    let error = metrics::mean_joint_position_error(&original, &converted, None).unwrap();
+    assert!(error < 1e-3, "mean joint position error {error} cm");
+}
