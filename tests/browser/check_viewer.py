@@ -1,0 +1,339 @@
+#!/usr/bin/env python3
+"""Browser test of the mocap viewer, in a real headless Chromium.
+
+Starts the viewer on a free loopback port with the given motion files,
+drives Chromium through chromedriver (the W3C WebDriver protocol, spoken
+with the standard library only), and checks what a person would:
+
+- the page loads and shows one skeleton per file, with the frame and joint
+  counts written in the files (read here from the BVH text, independently of
+  the Rust reader);
+- pressing Play advances the frames, and Pause stops them;
+- the scrubber moves to a chosen frame;
+- hovering a joint names it;
+- a screenshot is not blank: the motions' colours are on it.
+
+Usage: check_viewer.py --viewer PATH_TO_VIEW_BINARY [--out DIR] FILE.bvh...
+Prints one line per check and "N passed, N failed"; exits 1 on a failure.
+"""
+
+import argparse
+import base64
+import json
+import os
+import re
+import socket
+import struct
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+import zlib
+
+BACKGROUND = (0xF4, 0xF4, 0xF2)
+
+
+# ---------- a minimal WebDriver client ----------
+
+class WebDriver:
+    def __init__(self, base):
+        self.base = base
+        self.session = None
+
+    def call(self, method, path, body=None, timeout=60):
+        data = None if body is None else json.dumps(body).encode()
+        request = urllib.request.Request(
+            self.base + path, data=data, method=method,
+            headers={"Content-Type": "application/json"})
+        try:
+            with urllib.request.urlopen(request, timeout=timeout) as response:
+                return json.loads(response.read() or b"{}").get("value")
+        except urllib.error.HTTPError as e:
+            raise RuntimeError(f"WebDriver {method} {path}: {e.code} {e.read()[:500]!r}") from None
+
+    def start(self, chromium):
+        value = self.call("POST", "/session", {"capabilities": {"alwaysMatch": {
+            "browserName": "chrome",
+            "goog:chromeOptions": {
+                "binary": chromium,
+                "args": ["--headless=new", "--no-sandbox", "--disable-gpu",
+                         "--disable-dev-shm-usage", "--window-size=1200,800",
+                         "--force-device-scale-factor=1"],
+            },
+        }}})
+        self.session = value["sessionId"]
+
+    def s(self, path):
+        return f"/session/{self.session}{path}"
+
+    def get(self, url):
+        self.call("POST", self.s("/url"), {"url": url})
+
+    def js(self, script, *args):
+        return self.call("POST", self.s("/execute/sync"), {"script": script, "args": list(args)})
+
+    def click(self, css):
+        element = self.call("POST", self.s("/element"), {"using": "css selector", "value": css})
+        element_id = next(iter(element.values()))
+        self.call("POST", self.s(f"/element/{element_id}/click"), {})
+
+    def move_pointer(self, x, y):
+        self.call("POST", self.s("/actions"), {"actions": [{
+            "type": "pointer", "id": "mouse", "parameters": {"pointerType": "mouse"},
+            "actions": [{"type": "pointerMove", "duration": 0, "origin": "viewport",
+                         "x": int(x), "y": int(y)}]}]})
+
+    def screenshot(self):
+        return base64.b64decode(self.call("GET", self.s("/screenshot")))
+
+    def quit(self):
+        if self.session:
+            try:
+                self.call("DELETE", self.s(""), timeout=20)
+            except Exception:
+                pass
+
+
+# ---------- PNG decoding (8-bit RGB/RGBA, as Chromium writes) ----------
+
+def decode_png(data):
+    """Returns (width, height, channels, rows) with rows as bytearrays."""
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError("not a PNG")
+    pos, idat = 8, []
+    width = height = channels = None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunk = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", chunk)
+            if depth != 8 or colour not in (2, 6) or interlace != 0:
+                raise ValueError(f"unsupported PNG (depth {depth}, colour type {colour}, interlace {interlace})")
+            channels = 3 if colour == 2 else 4
+        elif kind == b"IDAT":
+            idat.append(chunk)
+        elif kind == b"IEND":
+            break
+    raw = zlib.decompress(b"".join(idat))
+    stride = width * channels
+    rows, previous = [], bytearray(stride)
+    for y in range(height):
+        start = y * (stride + 1)
+        kind, row = raw[start], bytearray(raw[start + 1:start + 1 + stride])
+        if kind == 1:
+            for i in range(channels, stride):
+                row[i] = (row[i] + row[i - channels]) & 255
+        elif kind == 2:
+            for i in range(stride):
+                row[i] = (row[i] + previous[i]) & 255
+        elif kind == 3:
+            for i in range(stride):
+                left = row[i - channels] if i >= channels else 0
+                row[i] = (row[i] + ((left + previous[i]) >> 1)) & 255
+        elif kind == 4:
+            for i in range(stride):
+                a = row[i - channels] if i >= channels else 0
+                b = previous[i]
+                c = previous[i - channels] if i >= channels else 0
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                pred = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                row[i] = (row[i] + pred) & 255
+        rows.append(row)
+        previous = row
+    return width, height, channels, rows
+
+
+def hex_rgb(colour):
+    return tuple(int(colour[k:k + 2], 16) for k in (1, 3, 5))
+
+
+# ---------- what the files say ----------
+
+def bvh_counts(path):
+    """(frames, joints) as written in a BVH file's text."""
+    text = open(path, encoding="utf-8", errors="replace").read()
+    frames = int(re.search(r"Frames:\s*(\d+)", text).group(1))
+    joints = len(re.findall(r"^\s*(?:ROOT|JOINT)\s", text, re.M))
+    return frames, joints
+
+
+# ---------- helpers ----------
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(condition, timeout, what):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.1)
+    raise TimeoutError(f"timed out after {timeout} s waiting for {what}")
+
+
+class Checks:
+    def __init__(self):
+        self.passed = 0
+        self.failed = 0
+
+    def check(self, name, ok, detail=""):
+        print(("ok   " if ok else "FAIL ") + name + (f": {detail}" if detail else ""), flush=True)
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+        return ok
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--viewer", required=True, help="the viewer binary (mocap-view's `view` example)")
+    parser.add_argument("--chromium", default="/usr/bin/chromium")
+    parser.add_argument("--chromedriver", default="/usr/bin/chromedriver")
+    parser.add_argument("--out", default=None, help="folder for the screenshot")
+    parser.add_argument("files", nargs="+")
+    args = parser.parse_args()
+
+    expected = [bvh_counts(f) for f in args.files]
+    checks = Checks()
+    processes = []
+    driver = None
+    try:
+        # The viewer, on a free port of its choosing (port 0); it prints the
+        # address on standard error.
+        server = subprocess.Popen([args.viewer, "view", "--port", "0", *args.files],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        processes.append(server)
+        line = server.stderr.readline()
+        match = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        if not match:
+            raise RuntimeError(f"the viewer did not start: {line.strip()}")
+        url = match.group(0)
+        print(f"viewer at {url}", flush=True)
+
+        port = free_port()
+        chromedriver = subprocess.Popen([args.chromedriver, f"--port={port}"],
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        processes.append(chromedriver)
+        driver = WebDriver(f"http://127.0.0.1:{port}")
+        wait_for(lambda: _status_ok(driver), 30, "chromedriver")
+        driver.start(args.chromium)
+        driver.get(url)
+
+        # The page loads and reads the scene.
+        wait_for(lambda: driver.js("return document.body.dataset.ready === '1'"), 30, "the scene")
+        error = driver.js("return getComputedStyle(document.getElementById('error')).display")
+        checks.check("page loads without error", error == "none")
+
+        motions = driver.js("return window.mocapViewer.motionCount()")
+        legend_rows = driver.js("return document.querySelectorAll('#motions .motion').length")
+        checks.check("one skeleton per file", motions == len(args.files) and legend_rows == len(args.files),
+                     f"{motions} motions, {legend_rows} legend rows, {len(args.files)} files")
+        frames = driver.js("return window.mocapViewer.frameCounts()")
+        checks.check("frame counts match the files", frames == [f for f, _ in expected],
+                     f"page {frames}, files {[f for f, _ in expected]}")
+        joints = driver.js("return window.mocapViewer.jointCounts()")
+        checks.check("joint counts match the files", joints == [j for _, j in expected],
+                     f"page {joints}, files {[j for _, j in expected]}")
+        label = driver.js("return document.getElementById('frame-label').textContent")
+        checks.check("frame label shows frame 0 and the first file's frame count",
+                     label.startswith(f"frame 0 · {expected[0][0]} frames"), repr(label))
+
+        # Play advances the frames; pause stops them.
+        start_frames = driver.js("return window.mocapViewer.currentFrames()")
+        driver.click("#play")
+        time.sleep(1.5)
+        playing_frames = driver.js("return window.mocapViewer.currentFrames()")
+        playing = driver.js("return window.mocapViewer.playing()")
+        checks.check("playing advances frames",
+                     playing and playing_frames[0] > start_frames[0],
+                     f"{start_frames} -> {playing_frames} after 1.5 s")
+        checks.check("the frame label follows",
+                     driver.js("return document.getElementById('frame-label').textContent") != label)
+        driver.click("#play")
+        paused = driver.js("return window.mocapViewer.currentFrames()")
+        time.sleep(0.5)
+        still = driver.js("return window.mocapViewer.currentFrames()")
+        checks.check("pause stops", paused == still and not driver.js("return window.mocapViewer.playing()"),
+                     f"{paused} -> {still}")
+
+        # The scrubber jumps to a frame (the middle of the first motion).
+        target = expected[0][0] // 2
+        driver.js("const s = document.getElementById('scrubber'); s.value = arguments[0];"
+                  "s.dispatchEvent(new Event('input'));", target)
+        time.sleep(0.2)
+        scrubbed = driver.js("return window.mocapViewer.currentFrames()")
+        checks.check("the scrubber sets the frame", scrubbed[0] == target, f"wanted {target}, got {scrubbed[0]}")
+
+        # Hovering a joint names it.
+        time.sleep(0.2)
+        root = driver.js("return window.mocapViewer.bodyRoot(0)")
+        spot = driver.js("const p = window.mocapViewer.jointOnScreen(0, arguments[0]);"
+                         "const r = document.getElementById('view').getBoundingClientRect();"
+                         "return p && {x: r.left + p.x / devicePixelRatio, y: r.top + p.y / devicePixelRatio};", root)
+        if spot:
+            driver.move_pointer(spot["x"], spot["y"])
+            time.sleep(0.3)
+            tip = driver.js("const t = document.getElementById('tooltip');"
+                            "return t.style.display === 'block' ? t.textContent : '';")
+            name = driver.js("return window.mocapViewer.pointName(0, arguments[0])", root)
+            checks.check("hovering a joint shows its name", name in tip, f"tooltip {tip!r}, joint {name!r}")
+            driver.move_pointer(5, 5)
+        else:
+            checks.check("hovering a joint shows its name", False, f"joint {root} of motion 0 is not on screen")
+
+        # The screenshot is not blank: each motion's colour is on it.
+        png = driver.screenshot()
+        out = args.out or os.environ.get("OUT") or "."
+        os.makedirs(out, exist_ok=True)
+        shot_path = os.path.join(out, "viewer-screenshot.png")
+        with open(shot_path, "wb") as f:
+            f.write(png)
+        width, height, channels, rows = decode_png(png)
+        colours = [hex_rgb(c) for c in driver.js("return window.mocapViewer.colours()")]
+        near = [0] * len(colours)
+        not_background = 0
+        for row in rows:
+            for i in range(0, width * channels, channels):
+                pixel = (row[i], row[i + 1], row[i + 2])
+                if max(abs(pixel[k] - BACKGROUND[k]) for k in range(3)) > 24:
+                    not_background += 1
+                for m, c in enumerate(colours):
+                    if max(abs(pixel[k] - c[k]) for k in range(3)) < 40:
+                        near[m] += 1
+        share = not_background / (width * height)
+        checks.check("screenshot is not blank", share > 0.01,
+                     f"{width}x{height}, {100 * share:.1f}% of pixels are not background; saved {shot_path}")
+        checks.check("every skeleton's colour is on the screenshot", all(n >= 50 for n in near),
+                     f"pixels per motion colour {near}")
+    except Exception as e:  # a check that could not run is a failure
+        checks.check("the browser test ran to the end", False, f"{type(e).__name__}: {e}")
+    finally:
+        if driver:
+            driver.quit()
+        for p in reversed(processes):
+            p.terminate()
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+    print(f"{checks.passed} passed, {checks.failed} failed", flush=True)
+    return 1 if checks.failed else 0
+
+
+def _status_ok(driver):
+    try:
+        return driver.call("GET", "/status", timeout=2).get("ready")
+    except Exception:
+        return False
+
+
+if __name__ == "__main__":
+    sys.exit(main())

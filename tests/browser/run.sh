@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Browser test of `mocap view` (the mocap-view crate's viewer) in a real
+# headless Chromium: installs Debian's chromium and chromium-driver when they
+# are missing, builds the viewer, and runs check_viewer.py on the bundled
+# sample and, when the shared data is there, a second Bandai take.
+#
+#   bash tests/browser/run.sh            # from anywhere in the repository
+#
+# The screenshot is kept in $OUT (default: target/browser-test/).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null 2>&1 \
+    || ! command -v python3 >/dev/null 2>&1; then
+    echo "== installing chromium, chromium-driver and python3 (Debian packages)"
+    SUDO=""
+    if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver python3 >/dev/null
+fi
+
+echo "== building the viewer"
+cargo build -q -p mocap-view --example view
+TARGET_DIR="${CARGO_TARGET_DIR:-target}"
+VIEWER="$TARGET_DIR/debug/examples/view"
+
+DATA="${MOCAP_SHARED_DATA:-../shared/data}"
+FILES=(samples/dataset-1_walk_normal_001.bvh)
+SECOND="$DATA/bandai/dataset-1/dataset-1_bow_active_001.bvh"
+if [ -f "$SECOND" ]; then
+    FILES+=("$SECOND")
+else
+    echo "note: $SECOND not found; testing with the bundled sample only"
+fi
+
+OUT_DIR="${OUT:-$TARGET_DIR/browser-test}"
+echo "== headless Chromium"
+python3 tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" \
+    --chromium "$(command -v chromium)" --chromedriver "$(command -v chromedriver)" "${FILES[@]}"
