@@ -289,6 +289,17 @@ def main():
         else:
             checks.check("hovering a joint shows its name", False, f"joint {root} of motion 0 is not on screen")
 
+        # Side by side: each motion on its own spot, left to right.
+        if len(args.files) > 1:
+            driver.js("const l = document.getElementById('layout'); l.value = 'side';"
+                      "l.dispatchEvent(new Event('change'));")
+            time.sleep(0.3)
+            xs = driver.js("const v = window.mocapViewer;"
+                           "return v.frameCounts().map((_, i) => { const p = v.jointOnScreen(i, v.bodyRoot(i));"
+                           "return p ? p.x : null; });")
+            checks.check("side by side puts the motions left to right",
+                         None not in xs and all(a + 20 < b for a, b in zip(xs, xs[1:])), f"hips at x = {xs}")
+
         # The screenshot is not blank: each motion's colour is on it.
         png = driver.screenshot()
         out = args.out or os.environ.get("OUT") or "."

@@ -28,7 +28,9 @@ pub enum Layout {
     /// On top of each other (noisy vs cleaned vs truth).
     #[default]
     Overlay,
-    /// Next to each other along x (source vs style vs output).
+    /// Next to each other along x (source vs style vs output), each kept
+    /// in place under its hips so that takes that travel differently stay
+    /// side by side.
     SideBySide,
 }
 
@@ -253,7 +255,10 @@ fn pick_frames(
 /// pictures of one render.
 struct Stage<'a> {
     scene: &'a Scene,
-    /// x shift of each motion (side by side).
+    /// Side by side: each motion is moved to its spot in the row, frame by
+    /// frame (see [`Stage::place`]).
+    in_place: bool,
+    /// x of each motion's spot in the row.
     offsets: Vec<f32>,
     floor_y: f32,
     /// Height the camera aims at.
@@ -278,15 +283,23 @@ impl<'a> Stage<'a> {
             .iter()
             .map(|m| m.bounding_box().unwrap_or((Vec3::ZERO, Vec3::ZERO)))
             .collect();
+        let in_place = options.layout == Layout::SideBySide;
         let mut offsets = vec![0.0; scene.motions.len()];
-        if options.layout == Layout::SideBySide {
-            // As the web viewer: each motion starts 0.5 m right of the box
-            // of the previous one; the row is centred.
-            for i in 1..offsets.len() {
-                offsets[i] = offsets[i - 1] + boxes[i - 1].1.x - boxes[i].0.x + 0.5;
+        if in_place {
+            // Each motion stands on its own spot of a row, its hips kept
+            // over it (as on a treadmill), so that takes that travel
+            // differently still stand side by side. The spacing is the
+            // widest figure's span plus 0.3 m.
+            let reach = scene
+                .motions
+                .iter()
+                .map(|m| m.horizontal_reach())
+                .fold(0.0, f32::max);
+            let spacing = 2.0 * reach + 0.3;
+            let middle = (offsets.len() as f32 - 1.0) / 2.0;
+            for (i, o) in offsets.iter_mut().enumerate() {
+                *o = (i as f32 - middle) * spacing;
             }
-            let mean = offsets.iter().sum::<f32>() / offsets.len() as f32;
-            offsets.iter_mut().for_each(|o| *o -= mean);
         }
         let floor_y = boxes.iter().map(|b| b.0.y).fold(f32::INFINITY, f32::min);
         let top_y = boxes
@@ -295,6 +308,7 @@ impl<'a> Stage<'a> {
             .fold(f32::NEG_INFINITY, f32::max);
         let mut stage = Stage {
             scene,
+            in_place,
             offsets,
             floor_y,
             aim_y: (floor_y + top_y) / 2.0,
@@ -313,13 +327,14 @@ impl<'a> Stage<'a> {
                 if m.frame_count == 0 {
                     continue;
                 }
-                let positions = m.frame_positions(stage.motion_frame(m, f));
+                let frame = stage.motion_frame(m, f);
+                let positions = m.frame_positions(frame);
                 for (_, &p) in positions
                     .iter()
                     .enumerate()
                     .filter(|&(p, _)| m.point_shown(p))
                 {
-                    let p = p + Vec3::X * stage.offsets[i];
+                    let p = stage.place(i, frame, p);
                     radius = radius.max((p - centre).length());
                 }
             }
@@ -334,6 +349,18 @@ impl<'a> Stage<'a> {
         ((t / m.frame_time + 1e-6).floor() as usize).min(m.frame_count.saturating_sub(1))
     }
 
+    /// Where point `p` of motion `i` in its `frame` is drawn: where it is,
+    /// or, side by side, moved so that the motion's body root is over its
+    /// spot in the row.
+    fn place(&self, i: usize, frame: usize, p: Vec3) -> Vec3 {
+        if !self.in_place {
+            return p;
+        }
+        let m = &self.scene.motions[i];
+        let root = m.frame_positions(frame)[m.body_root()];
+        p - Vec3::new(root.x, 0.0, root.z) + Vec3::X * self.offsets[i]
+    }
+
     /// Where the camera aims at timeline frame `f`: above the mean of the
     /// motions' root points.
     fn centre(&self, f: usize) -> Vec3 {
@@ -343,8 +370,8 @@ impl<'a> Stage<'a> {
             if m.frame_count == 0 {
                 continue;
             }
-            let p = m.frame_positions(self.motion_frame(m, f))[m.body_root()];
-            sum += p + Vec3::X * self.offsets[i];
+            let frame = self.motion_frame(m, f);
+            sum += self.place(i, frame, m.frame_positions(frame)[m.body_root()]);
             n += 1;
         }
         let c = if n > 0 { sum / n as f32 } else { Vec3::ZERO };
@@ -433,7 +460,7 @@ impl<'a> Stage<'a> {
             let points: Vec<Vec3> = m
                 .frame_positions(frame)
                 .iter()
-                .map(|&p| camera.to_camera(p + Vec3::X * self.offsets[i]))
+                .map(|&p| camera.to_camera(self.place(i, frame, p)))
                 .collect();
             for (p, &cam) in points.iter().enumerate() {
                 let rgb = match m.joint_confidence(frame, p) {

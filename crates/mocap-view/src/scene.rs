@@ -251,6 +251,26 @@ impl ViewMotion {
             .unwrap_or(0)
     }
 
+    /// The farthest any shown point gets horizontally from the body root
+    /// over the take (half the figure's widest horizontal span).
+    pub fn horizontal_reach(&self) -> f32 {
+        let root = self.body_root();
+        let shown: Vec<bool> = (0..self.point_count())
+            .map(|p| self.point_shown(p))
+            .collect();
+        let mut reach: f32 = 0.0;
+        for f in 0..self.frame_count {
+            let points = self.frame_positions(f);
+            for (p, &q) in points.iter().enumerate() {
+                if shown[p] {
+                    let d = q - points[root];
+                    reach = reach.max(d.x.hypot(d.z));
+                }
+            }
+        }
+        reach
+    }
+
     /// Number of points (joints and end sites).
     pub fn point_count(&self) -> usize {
         self.names.len()

@@ -17,11 +17,13 @@
 
   const FOV = 45 * Math.PI / 180;
   const NEAR = 0.05;
-  const GAP = 0.5; // metres between motions side by side
+  const GAP = 0.3; // metres between figures side by side
 
   let scene = null;         // the parsed scene.json
   let bounds = [];          // per motion: {min:[x,y,z], max:[x,y,z]}
-  let offsets = [];         // per motion: x shift for the current layout
+  let offsets = [];         // per motion: x of its spot in the row (side by side)
+  let roots = [];           // per motion: the point kept over its spot (the hips)
+  let reaches = [];         // per motion: farthest horizontal distance of a point from the root
   let floorY = 0;
   let clock = { t: 0, duration: 0, step: 1 / 30, playing: false, last: 0 };
   let camera = { yaw: 0.5, pitch: 0.25, distance: 4, target: [0, 1, 0] };
@@ -45,6 +47,8 @@
     scene = data;
     hidden = scene.motions.map(() => false);
     bounds = scene.motions.map(motionBounds);
+    roots = scene.motions.map(rootPoint);
+    reaches = scene.motions.map(horizontalReach);
     floorY = Math.min(...bounds.map((b) => b.min[1]));
     const steps = scene.motions.map((m) => m.frame_time);
     clock.step = Math.min(...steps);
@@ -79,21 +83,41 @@
     return { min, max };
   }
 
-  function updateLayout() {
-    offsets = scene.motions.map(() => 0);
-    if (layoutSelect.value === "side") {
-      // Each motion starts GAP metres to the right of the previous one's box;
-      // then the row is centred where the overlaid motions were.
-      for (let i = 1; i < offsets.length; i++) {
-        offsets[i] = offsets[i - 1] + bounds[i - 1].max[0] - bounds[i].min[0] + GAP;
+  function horizontalReach(m, i) {
+    const n = m.names.length, p = m.positions, root = roots[i];
+    let reach = 0;
+    for (let f = 0; f < m.frame_count; f++) {
+      const r = (f * n + root) * 3;
+      for (let q = 0; q < n; q++) {
+        if (!m.shown[q]) continue;
+        const k = (f * n + q) * 3;
+        reach = Math.max(reach, Math.hypot(p[k] - p[r], p[k + 2] - p[r + 2]));
       }
-      const mean = offsets.reduce((a, b) => a + b, 0) / offsets.length;
-      offsets = offsets.map((o) => o - mean);
     }
+    return reach;
+  }
+
+  function sideBySide() {
+    return layoutSelect.value === "side";
+  }
+
+  // Side by side, each motion stands on its own spot of a row with its hips
+  // kept over it (as on a treadmill), so that takes that travel differently
+  // still stand next to each other (as mocap_view::render does).
+  function updateLayout() {
+    const spacing = 2 * Math.max(...reaches) + GAP;
+    offsets = scene.motions.map((m, i) => (sideBySide() ? (i - (scene.motions.length - 1) / 2) * spacing : 0));
   }
 
   function sceneBox() {
     const min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
+    if (sideBySide()) {
+      const reach = Math.max(...reaches);
+      return {
+        min: [Math.min(...offsets) - reach, Math.min(...bounds.map((b) => b.min[1])), -reach],
+        max: [Math.max(...offsets) + reach, Math.max(...bounds.map((b) => b.max[1])), reach],
+      };
+    }
     scene.motions.forEach((m, i) => {
       for (let k = 0; k < 3; k++) {
         const shift = k === 0 ? offsets[i] : 0;
@@ -111,8 +135,8 @@
     const centre = [0, 1, 2].map((k) => (box.min[k] + box.max[k]) / 2);
     const height = Math.max(0.5, box.max[1] - box.min[1]);
     const travel = Math.hypot(box.max[0] - box.min[0], box.max[2] - box.min[2]);
-    const spread = layoutSelect.value === "side" ? (Math.max(...offsets) - Math.min(...offsets)) / 2 : 0;
-    followBox.checked = travel - 2 * spread > 2.5 * height;
+    const spread = sideBySide() ? (Math.max(...offsets) - Math.min(...offsets)) / 2 : 0;
+    followBox.checked = !sideBySide() && travel > 2.5 * height;
     const radius = followBox.checked
       ? 0.7 * height + spread
       : Math.max(0.5, Math.hypot(box.max[0] - box.min[0], height, box.max[2] - box.min[2]) / 2);
@@ -204,9 +228,18 @@
     return "hsl(" + Math.round(120 * c) + ",85%," + (c > 0.5 ? 40 : 45) + "%)";
   }
 
+  // Where a point is drawn in the current layout.
   function pointPosition(m, i, frame, point) {
+    const n = m.names.length, k = (frame * n + point) * 3;
+    if (!sideBySide()) return [m.positions[k], m.positions[k + 1], m.positions[k + 2]];
+    const r = (frame * n + roots[i]) * 3;
+    return [m.positions[k] - m.positions[r] + offsets[i], m.positions[k + 1], m.positions[k + 2] - m.positions[r + 2]];
+  }
+
+  // Where a point is in the file (metres).
+  function rawPosition(m, frame, point) {
     const k = (frame * m.names.length + point) * 3;
-    return [m.positions[k] + offsets[i], m.positions[k + 1], m.positions[k + 2]];
+    return [m.positions[k], m.positions[k + 1], m.positions[k + 2]];
   }
 
   function pointConfidence(m, frame, point) {
@@ -409,7 +442,7 @@
     if (!best) { tooltip.style.display = "none"; return; }
     const m = scene.motions[best.motion];
     const conf = pointConfidence(m, best.frame, best.point);
-    const pos = pointPosition(m, best.motion, best.frame, best.point).map((v, k) => (k === 0 ? v - offsets[best.motion] : v));
+    const pos = rawPosition(m, best.frame, best.point);
     tooltip.textContent = m.names[best.point] + "  (" + m.label + ")" +
       (conf !== null ? "\nconfidence " + conf.toFixed(2) : "") +
       "\n" + pos.map((v) => v.toFixed(3)).join(", ") + " m";
