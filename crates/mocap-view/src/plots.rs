@@ -38,9 +38,10 @@ macro_rules! draw_to {
             )));
         }
         let failed = |e: String| Error::Invalid(format!("{}: drawing failed: {e}", path.display()));
+        // Text is measured with the embedded font for SVG too.
+        register_fonts();
         match PlotFormat::of(path)? {
             PlotFormat::Png => {
-                register_fonts();
                 let mut pixels = vec![0u8; (width * height * 3) as usize];
                 {
                     let area = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
@@ -310,7 +311,8 @@ pub fn plot_bars(path: &Path, plot: &BarPlot) -> Result<()> {
     });
     let (lo, hi) = min_max(tops.filter(|v| v.is_finite()));
     let pad = (hi - lo).max(1e-6) * 0.08;
-    let y = if lo < 0.0 { lo - pad } else { 0.0 }..hi + pad;
+    // Room above the bars for the legend.
+    let y = if lo < 0.0 { lo - pad } else { 0.0 }..hi + 2.5 * pad;
     let x = -0.5f32..n as f32 - 0.5;
     let longest = plot
         .categories
@@ -343,31 +345,29 @@ fn draw_bars<DB: DrawingBackend>(
             .y_label_area_size(70)
             .build_cartesian_2d(x.clone(), y.clone())
             .map_err(|e| e.to_string())?;
-        let label_style = if rotate {
-            ("sans-serif", 12)
-                .into_font()
-                .transform(FontTransform::Rotate90)
-        } else {
-            ("sans-serif", 13).into_font()
-        };
         chart
             .configure_mesh()
             .disable_x_mesh()
             .x_labels(n + 1)
             .x_label_formatter(&|v: &f32| {
                 let i = v.round();
-                if (v - i).abs() < 1e-3 && i >= 0.0 && (i as usize) < n {
+                if !rotate && (v - i).abs() < 1e-3 && i >= 0.0 && (i as usize) < n {
                     plot.categories[i as usize].clone()
                 } else {
                     String::new()
                 }
             })
-            .x_label_style(label_style)
-            .y_desc(&plot.y_label)
             .label_style(("sans-serif", 13))
+            .y_desc(&plot.y_label)
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
             .map_err(|e| e.to_string())?;
+        if rotate {
+            let ticks: Vec<(i32, i32)> = (0..n)
+                .map(|c| chart.backend_coord(&(c as f32, y.start)))
+                .collect();
+            vertical_labels(area, &ticks, &plot.categories)?;
+        }
         let groups = plot.series.len() as f32;
         let width = 0.8 / groups;
         for (s, series) in plot.series.iter().enumerate() {
@@ -499,11 +499,12 @@ fn draw_confusion<DB: DrawingBackend>(
     cell_font: u32,
 ) -> std::result::Result<(), String> {
     let n = plot.labels.len();
+    let rotate = n > 6 || longest as usize * n > 60;
     {
         let mut chart = ChartBuilder::on(area)
             .caption(&plot.title, ("sans-serif", 20))
             .margin(12)
-            .x_label_area_size(24 + 7 * longest)
+            .x_label_area_size(if rotate { 24 + 7 * longest } else { 40 })
             .y_label_area_size(24 + 7 * longest)
             .build_cartesian_2d(-0.5f32..n as f32 - 0.5, -0.5f32..n as f32 - 0.5)
             .map_err(|e| e.to_string())?;
@@ -522,13 +523,15 @@ fn draw_confusion<DB: DrawingBackend>(
             .disable_mesh()
             .x_labels(n + 1)
             .y_labels(n + 1)
-            .x_label_formatter(&|v| name(*v, false))
+            .x_label_formatter(&|v| {
+                if rotate {
+                    String::new()
+                } else {
+                    name(*v, false)
+                }
+            })
             .y_label_formatter(&|v| name(*v, true))
-            .x_label_style(
-                ("sans-serif", 12)
-                    .into_font()
-                    .transform(FontTransform::Rotate90),
-            )
+            // The general label style first: it sets the x labels' too.
             .label_style(("sans-serif", 12))
             .x_desc("found")
             .y_desc("true")
@@ -567,12 +570,40 @@ fn draw_confusion<DB: DrawingBackend>(
                 ));
             }
         }
+        if rotate {
+            let ticks: Vec<(i32, i32)> = (0..n)
+                .map(|c| chart.backend_coord(&(c as f32, -0.5)))
+                .collect();
+            vertical_labels(area, &ticks, &plot.labels)?;
+        }
         chart.draw_series(cells).map_err(|e| e.to_string())?;
         if n <= 30 {
             chart.draw_series(labels).map_err(|e| e.to_string())?;
         }
         Ok(())
     }
+}
+
+/// Category names written downwards under their ticks (`ticks` in pixels,
+/// on the x axis): many joint names side by side would overlap. Drawn here
+/// because plotters' axis labels keep their own anchor, which rotated text
+/// needs changed.
+fn vertical_labels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    ticks: &[(i32, i32)],
+    names: &[String],
+) -> std::result::Result<(), String> {
+    let style = ("sans-serif", 12)
+        .into_font()
+        .transform(FontTransform::Rotate90)
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    for (&(x, y), name) in ticks.iter().zip(names) {
+        let name: String = name.chars().take(24).collect();
+        area.draw(&Text::new(name, (x, y + 8), style.clone()))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// White (0) to dark blue (1).
