@@ -10,8 +10,8 @@
 //! (default 5) or `--by-performer` or `--test DIR` (the positional folders
 //! are then the training clips); `--trees T`, `--candidates K`,
 //! `--min-entropy E`, `--frames N`, `--seed S`; `--no-baselines`,
-//! `--no-unseen`, `--no-takes`; `--json`; `--out FILE` writes the report
-//! there too (atomically).
+//! `--no-unseen`, `--no-takes`; `--name NAME` (the data's name in the
+//! report); `--json`; `--out FILE` writes the report there too (atomically).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,6 +41,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         ..EvalConfig::default()
     };
     let mut json = false;
+    let mut name: Option<String> = None;
     let mut out: Option<PathBuf> = None;
     let value = |args: &mut dyn Iterator<Item = String>, flag: &str| {
         args.next().ok_or_else(|| format!("{flag} needs a value"))
@@ -76,6 +77,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             "--no-baselines" => config.baselines = false,
             "--no-unseen" => config.unseen_classes = false,
             "--no-takes" => config.takes = false,
+            "--name" => name = Some(value(&mut args, &arg)?),
             "--json" => json = true,
             "--out" => out = Some(PathBuf::from(value(&mut args, &arg)?)),
             flag if flag.starts_with("--") => return Err(format!("unknown option {flag}").into()),
@@ -86,11 +88,12 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     if dirs.is_empty() {
         return Err("give at least one folder of clips".into());
     }
-    let dataset = dirs
-        .iter()
-        .map(|d| d.display().to_string())
-        .collect::<Vec<_>>()
-        .join(" + ");
+    let dataset = name.unwrap_or_else(|| {
+        dirs.iter()
+            .map(|d| d.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" + ")
+    });
     let clips = load_clips(&motion_files(&dirs)?, &rule, true)?;
     let report = if test_dirs.is_empty() {
         evaluate(&clips, &dataset, &rule_name, &config)?

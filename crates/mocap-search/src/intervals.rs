@@ -86,10 +86,13 @@ impl RunningSums {
 
     /// Mean of value `i` over frames `[t0, t1)` in constant time; fractional
     /// bounds weigh the partial frames. Returns the value at `t0` when the
-    /// range is empty.
+    /// range is empty, and 0 for a sequence without frames.
     pub fn mean(&self, i: usize, t0: f64, t1: f64) -> f32 {
+        let frames = self.frame_count();
+        if frames == 0 {
+            return 0.0;
+        }
         if t1 - t0 < 1e-9 {
-            let frames = self.frame_count();
             let f = (t0.floor() as usize).min(frames.saturating_sub(1));
             return (self.sums[(f + 1) * self.dim + i] - self.sums[f * self.dim + i]) as f32;
         }

@@ -31,7 +31,10 @@ pub enum TakeMethod {
     SubsequenceDtw,
 }
 
-/// How a take is searched.
+/// How a take is searched. The default, windows compared by their forest
+/// histograms, found the clips of the query's class best in the long-take
+/// experiment of `bench/results/search.md` (subsequence DTW and feature
+/// distance localise less well on Bandai takes).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TakeSearchConfig {
     pub method: TakeMethod,
@@ -53,11 +56,11 @@ pub struct TakeSearchConfig {
 impl Default for TakeSearchConfig {
     fn default() -> Self {
         TakeSearchConfig {
-            method: TakeMethod::SubsequenceDtw,
+            method: TakeMethod::Windows,
             dtw_fps: 10.0,
             scales: vec![0.5, 0.7, 1.0, 1.4, 2.0],
             hop: 0.1,
-            ranking: Ranking::Features,
+            ranking: Ranking::Histogram,
             top: 10,
             max_overlap: 0.3,
         }
