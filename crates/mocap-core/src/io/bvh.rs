@@ -230,8 +230,10 @@ pub fn write_bvh_to(writer: &mut dyn Write, motion: &Motion) -> io::Result<()> {
 }
 
 fn check_writable_name(name: &str) -> io::Result<()> {
-    let bad =
-        name.is_empty() || name.contains(['\n', '\r']) || name.trim() != name || name.contains('{');
+    let bad = name.is_empty()
+        || name.chars().any(|c| c.is_control() && c != '\t')
+        || name.trim() != name
+        || name.contains('{');
     if bad {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -577,6 +579,14 @@ impl<R: BufRead> Parser<R> {
                     return Err(self.lines.error_here(
                         self.lines.line.len() + 1,
                         format!("expected a joint name after {keyword}"),
+                    ));
+                }
+                if let Some(bad) = name.chars().find(|&c| c.is_control() && c != '\t') {
+                    return Err(self.lines.error_here(
+                        name_column,
+                        format!(
+                            "joint name {name:?} holds the control character {bad:?}: expected printable text"
+                        ),
                     ));
                 }
                 if let Some(first) = name_lines.get(&name) {
