@@ -152,15 +152,43 @@ def hex_rgb(colour):
 
 # ---------- what the files say ----------
 
-def bvh_counts(path):
-    """(frames, joints) as written in a BVH file's text."""
+def file_counts(path):
+    """(frames, joints) as written in a BVH file's text, or in a fused
+    capture (.jsonl, one frame per line)."""
     text = open(path, encoding="utf-8", errors="replace").read()
+    if path.endswith(".jsonl"):
+        lines = [json.loads(line) for line in text.splitlines() if line.strip()]
+        return len(lines), len(lines[0]["joints"])
     frames = int(re.search(r"Frames:\s*(\d+)", text).group(1))
     joints = len(re.findall(r"^\s*(?:ROOT|JOINT)\s", text, re.M))
     return frames, joints
 
 
 # ---------- helpers ----------
+
+# Kinect v2 joints (SDK order) with a height above the floor and a side, for
+# the synthetic fused capture below.
+KINECT = [("SpineBase", 0.95, 0), ("SpineMid", 1.2, 0), ("Neck", 1.45, 0), ("Head", 1.6, 0),
+          ("ShoulderLeft", 1.4, -1), ("ElbowLeft", 1.1, -1), ("WristLeft", 0.85, -1), ("HandLeft", 0.8, -1),
+          ("ShoulderRight", 1.4, 1), ("ElbowRight", 1.1, 1), ("WristRight", 0.85, 1), ("HandRight", 0.8, 1),
+          ("HipLeft", 0.92, -1), ("KneeLeft", 0.5, -1), ("AnkleLeft", 0.08, -1), ("FootLeft", 0.02, -1),
+          ("HipRight", 0.92, 1), ("KneeRight", 0.5, 1), ("AnkleRight", 0.08, 1), ("FootRight", 0.02, 1),
+          ("SpineShoulder", 1.4, 0), ("HandTipLeft", 0.75, -1), ("ThumbLeft", 0.8, -1),
+          ("HandTipRight", 0.75, 1), ("ThumbRight", 0.8, 1)]
+
+
+def write_fused_capture(path, frames=90):
+    """A synthetic fused capture (the format mocap-fuse writes): a figure
+    swaying side to side whose left-side joints have confidence 0 and the
+    others 1, to check the confidence colours. Test data, not a capture."""
+    import math
+    with open(path, "w") as f:
+        for i in range(frames):
+            sway = 0.1 * math.sin(i / 10)
+            joints = [[round(sway + 0.2 * side, 4), height, 0.0] for _, height, side in KINECT]
+            confidence = [0.0 if side < 0 else 1.0 for _, _, side in KINECT]
+            f.write(json.dumps({"t": i / 30, "joints": joints, "confidence": confidence}) + "\n")
+
 
 def free_port():
     with socket.socket() as s:
@@ -198,10 +226,18 @@ def main():
     parser.add_argument("--chromium", default="/usr/bin/chromium")
     parser.add_argument("--chromedriver", default="/usr/bin/chromedriver")
     parser.add_argument("--out", default=None, help="folder for the screenshot")
+    parser.add_argument("--with-fused", action="store_true",
+                        help="add a synthetic fused capture with confidence (written to --out)")
     parser.add_argument("files", nargs="+")
     args = parser.parse_args()
+    out = args.out or os.environ.get("OUT") or "."
+    os.makedirs(out, exist_ok=True)
+    if args.with_fused:
+        fused = os.path.join(out, "fused-test.jsonl")
+        write_fused_capture(fused)
+        args.files.append(fused)
 
-    expected = [bvh_counts(f) for f in args.files]
+    expected = [file_counts(f) for f in args.files]
     checks = Checks()
     processes = []
     driver = None
@@ -302,13 +338,21 @@ def main():
 
         # The screenshot is not blank: each motion's colour is on it.
         png = driver.screenshot()
-        out = args.out or os.environ.get("OUT") or "."
-        os.makedirs(out, exist_ok=True)
         shot_path = os.path.join(out, "viewer-screenshot.png")
         with open(shot_path, "wb") as f:
             f.write(png)
         width, height, channels, rows = decode_png(png)
-        colours = [hex_rgb(c) for c in driver.js("return window.mocapViewer.colours()")]
+        # Motions with confidence are drawn in confidence colours (the page
+        # starts in that mode when a motion has confidence): look for red
+        # (0) and green (1) instead of their own colour.
+        has_confidence = driver.js("return window.mocapViewer.hasConfidence()")
+        colour_mode = driver.js("return document.getElementById('colour-by').value")
+        if any(has_confidence):
+            checks.check("confidence colouring is on for a fused capture", colour_mode == "confidence", colour_mode)
+        colours = [hex_rgb(c) for c, conf in zip(driver.js("return window.mocapViewer.colours()"), has_confidence)
+                   if not conf]
+        if any(has_confidence):
+            colours += [(212, 17, 17), (15, 188, 15)]  # hsl(0,85%,45%) and hsl(120,85%,40%)
         near = [0] * len(colours)
         not_background = 0
         for row in rows:
@@ -317,13 +361,13 @@ def main():
                 if max(abs(pixel[k] - BACKGROUND[k]) for k in range(3)) > 24:
                     not_background += 1
                 for m, c in enumerate(colours):
-                    if max(abs(pixel[k] - c[k]) for k in range(3)) < 40:
+                    if max(abs(pixel[k] - c[k]) for k in range(3)) < 25:
                         near[m] += 1
         share = not_background / (width * height)
         checks.check("screenshot is not blank", share > 0.01,
                      f"{width}x{height}, {100 * share:.1f}% of pixels are not background; saved {shot_path}")
-        checks.check("every skeleton's colour is on the screenshot", all(n >= 50 for n in near),
-                     f"pixels per motion colour {near}")
+        checks.check("every skeleton's colour (and red and green for confidence) is on the screenshot",
+                     all(n >= 50 for n in near), f"pixels per colour {near}")
     except Exception as e:  # a check that could not run is a failure
         checks.check("the browser test ran to the end", False, f"{type(e).__name__}: {e}")
     finally:

@@ -2,7 +2,8 @@
 # Browser test of `mocap view` (the mocap-view crate's viewer) in a real
 # headless Chromium: installs Debian's chromium and chromium-driver when they
 # are missing, builds the viewer, and runs check_viewer.py on the bundled
-# sample and, when the shared data is there, a second Bandai take.
+# sample, a second Bandai take when the shared data is there, and a small
+# synthetic fused capture with confidence (written by the script).
 #
 #   bash tests/browser/run.sh            # from anywhere in the repository
 #
@@ -35,5 +36,5 @@ fi
 
 OUT_DIR="${OUT:-$TARGET_DIR/browser-test}"
 echo "== headless Chromium"
-python3 tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" \
+python3 tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" --with-fused \
     --chromium "$(command -v chromium)" --chromedriver "$(command -v chromedriver)" "${FILES[@]}"

@@ -45,7 +45,9 @@ pub struct ViewMotion {
     pub source: Option<String>,
     /// Names of the points: joints first, then end sites (`"<joint> end"`).
     pub names: Vec<String>,
-    /// Parent point of each point (`None` for roots); always an earlier point.
+    /// Parent point of each point (`None` for roots). Joints from files are
+    /// in parent-before-child order; captures given as positions may not be
+    /// (Kinect v2); end sites always follow their joint.
     pub parents: Vec<Option<usize>>,
     /// How many of the points are joints (the rest are end sites).
     pub joint_count: usize,
@@ -142,13 +144,14 @@ impl ViewMotion {
                 parents.len()
             )));
         }
+        // Any order will do for drawing (Kinect's is not parent-before-child).
         if let Some((j, p)) = parents
             .iter()
             .enumerate()
-            .find_map(|(j, p)| p.filter(|&p| p >= j).map(|p| (j, p)))
+            .find_map(|(j, p)| p.filter(|&p| p >= n || p == j).map(|p| (j, p)))
         {
             return Err(Error::Invalid(format!(
-                "{label}: joint {j} ({}) has parent {p}, which is not an earlier joint",
+                "{label}: joint {j} ({}) has parent {p}, which is not another joint",
                 names[j]
             )));
         }
@@ -317,19 +320,38 @@ impl Scene {
     }
 
     /// Reads motion files (`.bvh`, or `.asf` followed by its `.amc` files,
-    /// as [`mocap_core::io::MotionSource::group`] pairs them), labelled by
-    /// file name.
+    /// as [`mocap_core::io::MotionSource::group`] pairs them) and captures
+    /// (`.jsonl`, see [`read_capture`]), labelled by file name.
     pub fn from_files(paths: &[PathBuf]) -> Result<Scene> {
         if paths.is_empty() {
             return Err(Error::Invalid("no motion files given".to_string()));
         }
-        let motions = read_motions(paths)?
-            .into_iter()
-            .map(|(source, motion)| {
-                let name = source.display_name();
-                ViewMotion::from_motion(file_label(Path::new(&name)), &motion).with_source(name)
-            })
-            .collect();
+        let mut motions = Vec::new();
+        // Runs of motion files go to mocap_core's reader (which pairs ASF
+        // and AMC files); each capture file is read on its own, in order.
+        let mut run: Vec<PathBuf> = Vec::new();
+        let flush = |run: &mut Vec<PathBuf>, motions: &mut Vec<ViewMotion>| -> Result<()> {
+            if !run.is_empty() {
+                for (source, motion) in read_motions(run)? {
+                    let name = source.display_name();
+                    motions.push(
+                        ViewMotion::from_motion(file_label(Path::new(&name)), &motion)
+                            .with_source(name),
+                    );
+                }
+                run.clear();
+            }
+            Ok(())
+        };
+        for path in paths {
+            if is_capture(path) {
+                flush(&mut run, &mut motions)?;
+                motions.extend(read_capture(path)?);
+            } else {
+                run.push(path.clone());
+            }
+        }
+        flush(&mut run, &mut motions)?;
         Ok(Scene::new(motions))
     }
 
@@ -483,4 +505,171 @@ pub fn guess_metres_per_unit(extent: f32) -> f32 {
         e if (300.0..=4000.0).contains(&e) => 0.001,
         _ => 1.0,
     }
+}
+
+fn is_capture(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("jsonl"))
+}
+
+/// Reads a Kinect v2 capture written by `mocap-fuse` (JSON lines, 25 joints
+/// in Kinect v2 order, metres, y up):
+///
+/// - a **fused** capture, one line per frame:
+///   `{"t": s, "joints": [[x, y, z], ...], "confidence": [c, ...]}`; the
+///   confidence of a joint is the sum of the confidences of the sensors
+///   that saw it, shown as `min(c, 1)` (at least one fully trusted view is
+///   green);
+/// - a **sensor recording**, one line per frame per sensor:
+///   `{"v": 1, "sensor": k, "seq": n, "t": s, "joints": [[x, y, z, state], ...]}`;
+///   one motion per sensor, its confidence the tracking state (tracked 1,
+///   inferred 0.5, not tracked 0).
+///
+/// Frames are put in time order and played at the median interval between
+/// them.
+pub fn read_capture(path: &Path) -> Result<Vec<ViewMotion>> {
+    use mocap_core::bodymap::KINECT_V2_JOINTS;
+    use mocap_core::error::{Location, ParseError};
+    use std::collections::BTreeMap;
+
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let at = |line: usize, message: String| {
+        Error::Parse(ParseError {
+            location: Location {
+                path: path.to_path_buf(),
+                line,
+                column: 1,
+            },
+            message,
+        })
+    };
+    let joint_count = KINECT_V2_JOINTS.len();
+    // Per stream (a sensor id, or None for fused frames): (time, points, confidence).
+    type Frame = (f64, Vec<Vec3>, Vec<f32>);
+    let mut streams: BTreeMap<Option<u64>, Vec<Frame>> = BTreeMap::new();
+    for (index, line) in text.lines().enumerate() {
+        let number = index + 1;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let value: serde_json::Value = serde_json::from_str(line)
+            .map_err(|e| at(number, format!("not a JSON object: {e}")))?;
+        let time = value["t"]
+            .as_f64()
+            .filter(|t| t.is_finite())
+            .ok_or_else(|| at(number, "expected a time `t` in seconds".to_string()))?;
+        let sensor = match &value["sensor"] {
+            serde_json::Value::Null => None,
+            v => Some(
+                v.as_u64()
+                    .ok_or_else(|| at(number, "`sensor` must be a whole number".to_string()))?,
+            ),
+        };
+        let joints = value["joints"]
+            .as_array()
+            .filter(|j| j.len() == joint_count)
+            .ok_or_else(|| {
+                at(
+                    number,
+                    format!("expected `joints`: {joint_count} Kinect v2 joints"),
+                )
+            })?;
+        let width = if sensor.is_some() { 4 } else { 3 };
+        let mut points = Vec::with_capacity(joint_count);
+        let mut confidence = Vec::with_capacity(joint_count);
+        for (j, joint) in joints.iter().enumerate() {
+            let numbers: Vec<f64> = joint
+                .as_array()
+                .filter(|a| a.len() == width)
+                .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
+                .filter(|n: &Vec<f64>| n.len() == width && n.iter().all(|v| v.is_finite()))
+                .ok_or_else(|| {
+                    at(
+                        number,
+                        format!(
+                            "joint {j} ({}): expected {}",
+                            KINECT_V2_JOINTS[j].0,
+                            if width == 4 {
+                                "[x, y, z, state]"
+                            } else {
+                                "[x, y, z]"
+                            }
+                        ),
+                    )
+                })?;
+            points.push(Vec3::new(
+                numbers[0] as f32,
+                numbers[1] as f32,
+                numbers[2] as f32,
+            ));
+            if width == 4 {
+                confidence.push(match numbers[3] as i64 {
+                    2 => 1.0,
+                    1 => 0.5,
+                    _ => 0.0,
+                });
+            }
+        }
+        if sensor.is_none() {
+            if let Some(c) = value["confidence"].as_array() {
+                let values: Vec<f32> = c
+                    .iter()
+                    .filter_map(|v| v.as_f64())
+                    .map(|v| v as f32)
+                    .collect();
+                if values.len() != joint_count || values.iter().any(|v| !v.is_finite()) {
+                    return Err(at(
+                        number,
+                        format!("expected `confidence`: {joint_count} numbers"),
+                    ));
+                }
+                confidence = values;
+            }
+        }
+        streams
+            .entry(sensor)
+            .or_default()
+            .push((time, points, confidence));
+    }
+    if streams.is_empty() {
+        return Err(at(1, "no frame in this capture".to_string()));
+    }
+    let names: Vec<String> = KINECT_V2_JOINTS
+        .iter()
+        .map(|(n, _)| n.to_string())
+        .collect();
+    let parents: Vec<Option<usize>> = KINECT_V2_JOINTS.iter().map(|&(_, p)| p).collect();
+    let stem = file_label(path);
+    let mut motions = Vec::new();
+    for (sensor, mut frames) in streams {
+        frames.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut steps: Vec<f64> = frames
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .filter(|d| *d > 0.0)
+            .collect();
+        steps.sort_by(f64::total_cmp);
+        let frame_time = steps.get(steps.len() / 2).copied().unwrap_or(1.0 / 30.0);
+        let has_confidence = frames.iter().all(|f| f.2.len() == joint_count);
+        let positions: Vec<Vec3> = frames.iter().flat_map(|f| f.1.iter().copied()).collect();
+        let label = match sensor {
+            Some(k) => format!("{stem} sensor {k}"),
+            None => stem.clone(),
+        };
+        let mut motion = ViewMotion::from_positions(
+            label,
+            names.clone(),
+            parents.clone(),
+            frame_time,
+            positions,
+            Some(1.0),
+        )?
+        .with_source(path.display().to_string());
+        if has_confidence {
+            motion = motion
+                .with_confidence(frames.iter().flat_map(|f| f.2.iter().copied()).collect())?;
+        }
+        motions.push(motion);
+    }
+    Ok(motions)
 }

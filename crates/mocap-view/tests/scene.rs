@@ -7,7 +7,7 @@ use mocap_core::io::asf_amc::read_asf_amc;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::kinematics::{end_site_positions, forward_kinematics};
 use mocap_core::rotation::Vec3;
-use mocap_view::scene::guess_metres_per_unit;
+use mocap_view::scene::{guess_metres_per_unit, read_capture};
 use mocap_view::{Scene, ViewMotion};
 
 fn workspace() -> PathBuf {
@@ -148,7 +148,10 @@ fn positions_and_confidence_are_checked() {
 
     let err = |r: mocap_core::Result<ViewMotion>| r.unwrap_err().to_string();
     assert!(err(ok(vec![None], two_frames.clone(), 0.1)).contains("2 joint names but 1 parents"));
-    assert!(err(ok(vec![Some(1), None], two_frames.clone(), 0.1)).contains("not an earlier joint"));
+    assert!(err(ok(vec![Some(2), None], two_frames.clone(), 0.1)).contains("not another joint"));
+    assert!(err(ok(vec![None, Some(1)], two_frames.clone(), 0.1)).contains("not another joint"));
+    // Children may come first, as in Kinect's joint order.
+    assert!(ok(vec![Some(1), None], two_frames.clone(), 0.1).is_ok());
     assert!(err(ok(vec![None, Some(0)], two_frames[..3].to_vec(), 0.1))
         .contains("whole number of frames"));
     assert!(err(ok(vec![None, Some(0)], two_frames.clone(), 0.0)).contains("frame time"));
@@ -245,4 +248,149 @@ fn hdm05_asf_amc_is_read_in_centimetres() {
     .unwrap();
     assert_eq!(scene.motions.len(), 1);
     assert_eq!(scene.motions[0].frame_count, motion.frame_count());
+}
+
+/// A Kinect v2 pose (25 joints, metres): a person 1.7 m tall standing 2 m
+/// in front of the sensor, moved `dx` to the side.
+fn kinect_pose(dx: f32) -> Vec<[f32; 3]> {
+    use mocap_core::bodymap::KINECT_V2_JOINTS;
+    // Heights of the joints above the floor (y = -1 m: the sensor is 1 m up).
+    let height = |name: &str| match name {
+        "Head" => 1.6,
+        "Neck" | "SpineShoulder" => 1.45,
+        n if n.starts_with("Shoulder") => 1.4,
+        n if n.starts_with("Elbow") => 1.1,
+        n if n.starts_with("Wrist") || n.starts_with("Hand") || n.starts_with("Thumb") => 0.85,
+        "SpineMid" => 1.2,
+        "SpineBase" => 0.95,
+        n if n.starts_with("Hip") => 0.92,
+        n if n.starts_with("Knee") => 0.5,
+        n if n.starts_with("Ankle") => 0.08,
+        _ => 0.02,
+    };
+    KINECT_V2_JOINTS
+        .iter()
+        .map(|(name, _)| {
+            let side = if name.ends_with("Left") {
+                -0.2
+            } else if name.ends_with("Right") {
+                0.2
+            } else {
+                0.0
+            };
+            [dx + side, height(name) - 1.0, 2.0]
+        })
+        .collect()
+}
+
+fn joints_json(pose: &[[f32; 3]], state: Option<u8>) -> String {
+    let items: Vec<String> = pose
+        .iter()
+        .map(|p| match state {
+            Some(s) => format!("[{},{},{},{s}]", p[0], p[1], p[2]),
+            None => format!("[{},{},{}]", p[0], p[1], p[2]),
+        })
+        .collect();
+    format!("[{}]", items.join(","))
+}
+
+#[test]
+fn fused_capture_plays_with_its_confidence() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("fused.jsonl");
+    let mut text = String::new();
+    for f in 0..10 {
+        let mut confidence = vec![1.6f32; 25];
+        confidence[7] = 0.0; // HandLeft unseen
+        confidence[3] = 0.4;
+        let c: Vec<String> = confidence.iter().map(|c| c.to_string()).collect();
+        text += &format!(
+            "{{\"t\":{},\"joints\":{},\"confidence\":[{}]}}\n",
+            1.0 + f as f64 / 30.0,
+            joints_json(&kinect_pose(0.01 * f as f32), None),
+            c.join(",")
+        );
+    }
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::from_files(&[path.clone()]).unwrap();
+    assert_eq!(scene.motions.len(), 1);
+    let m = &scene.motions[0];
+    assert_eq!((m.frame_count, m.joint_count), (10, 25));
+    assert!((m.frame_time - 1.0 / 30.0).abs() < 1e-9);
+    assert_eq!(m.metres_per_unit, 1.0);
+    assert_eq!(m.names[m.body_root()], "SpineBase");
+    assert_eq!(m.joint_confidence(4, 7), Some(0.0));
+    assert_eq!(m.joint_confidence(4, 3), Some(0.4));
+    assert_eq!(
+        m.joint_confidence(4, 0),
+        Some(1.0),
+        "a sum over sensors is shown as at most 1"
+    );
+    assert!((m.frame_positions(9)[0].x - 0.09).abs() < 1e-6);
+    assert!((figure_height(m, 0) - 1.58).abs() < 1e-3);
+}
+
+#[test]
+fn sensor_recording_gives_one_motion_per_sensor() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sensors.jsonl");
+    let mut lines = Vec::new();
+    // Two sensors, lines out of time order.
+    for f in (0..6).rev() {
+        for sensor in [1, 0] {
+            let state = if sensor == 1 { 1 } else { 2 };
+            lines.push(format!(
+                "{{\"v\":1,\"sensor\":{sensor},\"seq\":{f},\"t\":{},\"joints\":{}}}",
+                f as f64 * 0.04,
+                joints_json(&kinect_pose(f as f32 * 0.1), Some(state))
+            ));
+        }
+    }
+    std::fs::write(&path, lines.join("\n")).unwrap();
+    let motions = read_capture(&path).unwrap();
+    assert_eq!(motions.len(), 2);
+    assert_eq!(motions[0].label, "sensors sensor 0");
+    assert_eq!(motions[1].label, "sensors sensor 1");
+    for m in &motions {
+        assert_eq!(m.frame_count, 6);
+        assert!((m.frame_time - 0.04).abs() < 1e-9);
+        // Sorted by time: the figure moves +x.
+        assert!(m.frame_positions(5)[0].x > m.frame_positions(0)[0].x);
+    }
+    assert_eq!(motions[0].joint_confidence(0, 0), Some(1.0), "tracked");
+    assert_eq!(motions[1].joint_confidence(0, 0), Some(0.5), "inferred");
+}
+
+#[test]
+fn broken_captures_name_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.jsonl");
+    let good = format!(
+        "{{\"t\":0,\"joints\":{}}}",
+        joints_json(&kinect_pose(0.0), None)
+    );
+    for (bad, expected) in [
+        ("{\"t\":0,\"joints\":[[0,0,0]]}", "25 Kinect v2 joints"),
+        ("not json", "not a JSON object"),
+        ("{\"joints\":[]}", "time `t`"),
+    ] {
+        std::fs::write(&path, format!("{good}\n{bad}\n")).unwrap();
+        let e = read_capture(&path).unwrap_err().to_string();
+        assert!(e.contains("bad.jsonl:2:1") && e.contains(expected), "{e}");
+    }
+    let mut pose = kinect_pose(0.0);
+    pose[5][1] = f32::NAN;
+    std::fs::write(&path, joints_json(&pose, None).replace("NaN", "null")).unwrap();
+    let line = format!(
+        "{{\"t\":0,\"joints\":{}}}",
+        joints_json(&pose, None).replace("NaN", "null")
+    );
+    std::fs::write(&path, line).unwrap();
+    let e = read_capture(&path).unwrap_err().to_string();
+    assert!(e.contains("joint 5 (ElbowLeft)"), "{e}");
+    std::fs::write(&path, "\n").unwrap();
+    assert!(read_capture(&path)
+        .unwrap_err()
+        .to_string()
+        .contains("no frame"));
 }

@@ -474,6 +474,7 @@
     jointCounts: () => (scene ? scene.motions.map((m) => m.joint_count) : []),
     labels: () => (scene ? scene.motions.map((m) => m.label) : []),
     colours: () => (scene ? scene.motions.map((m) => m.colour) : []),
+    hasConfidence: () => (scene ? scene.motions.map((m) => m.confidence !== null) : []),
     currentFrames: () => (scene ? scene.motions.map((m) => frameOf(m, clock.t)) : []),
     time: () => clock.t,
     playing: () => clock.playing,
