@@ -300,7 +300,7 @@ fn fused_capture_plays_with_its_confidence() {
     let path = dir.path().join("fused.jsonl");
     let mut text = String::new();
     for f in 0..10 {
-        let mut confidence = vec![1.6f32; 25];
+        let mut confidence = [1.6f32; 25];
         confidence[7] = 0.0; // HandLeft unseen
         confidence[3] = 0.4;
         let c: Vec<String> = confidence.iter().map(|c| c.to_string()).collect();
@@ -312,7 +312,7 @@ fn fused_capture_plays_with_its_confidence() {
         );
     }
     std::fs::write(&path, text).unwrap();
-    let scene = Scene::from_files(&[path.clone()]).unwrap();
+    let scene = Scene::from_files(std::slice::from_ref(&path)).unwrap();
     assert_eq!(scene.motions.len(), 1);
     let m = &scene.motions[0];
     assert_eq!((m.frame_count, m.joint_count), (10, 25));
