@@ -32,6 +32,8 @@ enum Command {
     Convert(commands::convert::Args),
     /// Global joint positions of every frame, as CSV or JSON.
     Positions(commands::positions::Args),
+    /// Motion retrieval by example: index a labelled library, query it, evaluate.
+    Search(commands::search::Args),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +43,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),
         Command::Positions(args) => commands::positions::run(args, &options),
+        Command::Search(args) => commands::search::run(args, &options),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,6 +4,7 @@
 pub mod convert;
 pub mod info;
 pub mod positions;
+pub mod search;
 
 use std::io::Write;
 use std::path::Path;

@@ -1,0 +1,93 @@
+//! `mocap search` end to end on a small real library.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mocap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args(args)
+        .output()
+        .expect("the mocap binary runs")
+}
+
+fn bandai() -> Option<PathBuf> {
+    let dir = std::env::var_os("MOCAP_SHARED_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
+        .join("bandai/dataset-2");
+    dir.is_dir().then_some(dir).or_else(|| {
+        eprintln!("note: Bandai data not found, skipping");
+        None
+    })
+}
+
+#[test]
+fn index_then_query_finds_the_category() {
+    let Some(data) = bandai() else { return };
+    // Four takes each of three contents; the query is a fifth walk, not indexed.
+    let mut library = Vec::new();
+    for content in ["walk", "run", "raise-up-both-hands"] {
+        for id in ["001", "004", "007", "010"] {
+            library.push(data.join(format!("dataset-2_{content}_normal_{id}.bvh")));
+        }
+    }
+    let query = data.join("dataset-2_walk_normal_013.bvh");
+    let dir = tempfile::tempdir().unwrap();
+    let index = dir.path().join("library.idx");
+    let mut args: Vec<String> = vec!["search".into(), "index".into()];
+    args.extend(library.iter().map(|p| p.display().to_string()));
+    args.extend(
+        [
+            "--labels-from-name",
+            "bandai-content",
+            "--trees",
+            "20",
+            "-o",
+            index.to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = mocap(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let out = mocap(&[
+        "search",
+        "query",
+        query.to_str().unwrap(),
+        "--index",
+        index.to_str().unwrap(),
+        "--top",
+        "3",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["predicted"], "walk");
+    assert_eq!(report["matches"].as_array().unwrap().len(), 3);
+    assert_eq!(report["matches"][0]["label"], "walk");
+
+    // A corrupted index is refused with a clear message.
+    let mut bytes = std::fs::read(&index).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0xff;
+    std::fs::write(&index, bytes).unwrap();
+    let out = mocap(&[
+        "search",
+        "query",
+        query.to_str().unwrap(),
+        "--index",
+        index.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(message.contains("library.idx"), "{message}");
+}
