@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use mocap_view::render::{parse_frame_range, resolve_frame_range, Layout, RenderOptions};
+use mocap_view::render::{FrameRange, Layout, RenderOptions};
 use mocap_view::{render, serve, Scene};
 
 fn main() -> ExitCode {
@@ -36,7 +36,7 @@ fn run(args: Vec<String>) -> Result<(), String> {
         match arg.as_str() {
             "--port" => port = value()?.parse().map_err(|_| "--port needs a number")?,
             "-o" | "--output" => output = Some(PathBuf::from(value()?)),
-            "--frames" => frames = Some(parse_frame_range(value()?).map_err(|e| e.to_string())?),
+            "--frames" => frames = Some(value()?.parse::<FrameRange>().map_err(|e| e.to_string())?),
             "--every" => every = Some(value()?.parse().map_err(|_| "--every needs a number")?),
             "--side" => layout = Layout::SideBySide,
             s if s.starts_with('-') => return Err(format!("unknown option {s}\n{usage}")),
@@ -48,9 +48,8 @@ fn run(args: Vec<String>) -> Result<(), String> {
         "view" => serve(&scene, port).map_err(|e| e.to_string()),
         "render" => {
             let output = output.ok_or("render needs -o OUT.png or -o OUT.gif")?;
-            let first = &scene.motions[0];
             let options = RenderOptions {
-                frames: frames.map(|r| resolve_frame_range(r, first.frame_count)),
+                frames,
                 every,
                 layout,
                 ..RenderOptions::default()

@@ -20,6 +20,6 @@ pub mod server;
 pub use plots::{
     plot_bars, plot_confusion, plot_lines, BarPlot, BarSeries, ConfusionPlot, LinePlot, Series,
 };
-pub use render::{parse_frame_range, render, render_files, Layout, RenderOptions, RenderSummary};
+pub use render::{render, render_files, FrameRange, Layout, RenderOptions, RenderSummary};
 pub use scene::{Scene, ViewMotion};
 pub use server::{serve, ViewerServer};

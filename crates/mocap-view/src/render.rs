@@ -38,8 +38,8 @@ pub enum Layout {
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
     /// Frames `A..B` (from 0, `B` excluded) on the clock of the first
-    /// motion; `None` for the whole take.
-    pub frames: Option<Range<usize>>,
+    /// motion; `None` for the whole take (as long as the longest motion).
+    pub frames: Option<FrameRange>,
     /// Draw every `N`th frame; `None` picks about 8 panels for a filmstrip
     /// and every frame (at most 50 per second) for a GIF.
     pub every: Option<usize>,
@@ -158,40 +158,58 @@ pub fn render(scene: &Scene, output: &Path, options: &RenderOptions) -> Result<R
     })
 }
 
-/// Parses a frame range as written on the command line: `A..B` (frames `A`
-/// up to, not including, `B`), `A..` or `..B`. `None` for an open end.
-pub fn parse_frame_range(text: &str) -> Result<(Option<usize>, Option<usize>)> {
-    let bad = || {
-        Error::Invalid(format!(
-            "frame range `{text}`: expected A..B (frames A up to, not including, B, counted from 0), A.. or ..B"
-        ))
-    };
-    let (a, b) = text.split_once("..").ok_or_else(bad)?;
-    let number = |s: &str| -> Result<Option<usize>> {
-        let s = s.trim();
-        if s.is_empty() {
-            Ok(None)
-        } else {
-            s.parse().map(Some).map_err(|_| bad())
-        }
-    };
-    let (a, b) = (number(a)?, number(b)?);
-    if let (Some(a), Some(b)) = (a, b) {
-        if a >= b {
-            return Err(Error::Invalid(format!(
-                "frame range `{text}` is empty: the first frame must come before the end"
-            )));
-        }
-    }
-    Ok((a, b))
+/// Frames to draw, as written on the command line: `A..B` (frames `A` up
+/// to, not including, `B`, counted from 0 on the first motion's clock),
+/// `A..` (to the end) or `..B` (from the start). Parse with `str::parse`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FrameRange {
+    pub start: Option<usize>,
+    pub end: Option<usize>,
 }
 
-/// Turns a parsed range into frames of a take of `frame_count` frames.
-pub fn resolve_frame_range(
-    range: (Option<usize>, Option<usize>),
-    frame_count: usize,
-) -> Range<usize> {
-    range.0.unwrap_or(0)..range.1.unwrap_or(frame_count)
+impl FrameRange {
+    /// The frames `range`.
+    pub fn new(range: Range<usize>) -> FrameRange {
+        FrameRange {
+            start: Some(range.start),
+            end: Some(range.end),
+        }
+    }
+
+    /// The frames of a timeline of `frame_count` frames.
+    pub fn resolve(&self, frame_count: usize) -> Range<usize> {
+        self.start.unwrap_or(0)..self.end.unwrap_or(frame_count)
+    }
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<FrameRange> {
+        let bad = || {
+            Error::Invalid(format!(
+                "frame range `{text}`: expected A..B (frames A up to, not including, B, counted from 0), A.. or ..B"
+            ))
+        };
+        let (a, b) = text.split_once("..").ok_or_else(bad)?;
+        let number = |s: &str| -> Result<Option<usize>> {
+            let s = s.trim();
+            if s.is_empty() {
+                Ok(None)
+            } else {
+                s.parse().map(Some).map_err(|_| bad())
+            }
+        };
+        let (start, end) = (number(a)?, number(b)?);
+        if let (Some(a), Some(b)) = (start, end) {
+            if a >= b {
+                return Err(Error::Invalid(format!(
+                    "frame range `{text}` is empty: the first frame must come before the end"
+                )));
+            }
+        }
+        Ok(FrameRange { start, end })
+    }
 }
 
 /// Frames on the first motion's clock: the timeline lasts as long as the
@@ -222,7 +240,7 @@ fn pick_frames(
             first.label
         )));
     }
-    let range = options.frames.clone().unwrap_or(0..total);
+    let range = options.frames.unwrap_or_default().resolve(total);
     if range.start >= range.end || range.end > total {
         return Err(Error::Invalid(format!(
             "frames {}..{} are not within the take, which has frames 0..{total}",
@@ -339,7 +357,8 @@ impl<'a> Stage<'a> {
                 }
             }
         }
-        stage.radius = radius * 1.05;
+        // A margin, so that the head and feet stay clear of the edges.
+        stage.radius = radius * 1.15;
         stage
     }
 
@@ -828,14 +847,22 @@ fn gif(
         for (k, &f) in frames.iter().enumerate() {
             let mut canvas = Canvas::new(width, height);
             canvas.paint(|area| {
-                draw_legend(area, stage.scene, (0, 0))?;
+                // The figure below the legend strip; then the strip, which
+                // covers whatever of the floor reached into it.
+                let top = LEGEND_HEIGHT as f32 * s;
                 stage.draw(
                     area,
                     f,
-                    (0.0, 0.0),
-                    (width as f32 * s, height as f32 * s),
+                    (0.0, top),
+                    (width as f32 * s, height as f32 * s - top),
                     s,
                 )?;
+                area.draw(&Rectangle::new(
+                    [(0, 0), ((width * SUPER) as i32, top as i32)],
+                    BACKGROUND.filled(),
+                ))
+                .map_err(|e| e.to_string())?;
+                draw_legend(area, stage.scene, (0, 0))?;
                 let caption = format!("frame {f}  {:.2} s", f as f64 * stage.frame_time);
                 frame_caption(
                     area,

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use image::AnimationDecoder;
 use mocap_core::rotation::Vec3;
-use mocap_view::render::{parse_frame_range, resolve_frame_range, Layout, RenderOptions};
+use mocap_view::render::{FrameRange, Layout, RenderOptions};
 use mocap_view::scene::PALETTE;
 use mocap_view::{render, Scene, ViewMotion};
 
@@ -68,7 +68,7 @@ fn frames_and_every_pick_the_panels() {
     let dir = tempfile::tempdir().unwrap();
     let scene = Scene::from_files(&[sample()]).unwrap();
     let options = RenderOptions {
-        frames: Some(10..21),
+        frames: Some(FrameRange::new(10..21)),
         every: Some(5),
         ..RenderOptions::default()
     };
@@ -76,14 +76,20 @@ fn frames_and_every_pick_the_panels() {
     assert_eq!(summary.frames, vec![10, 15, 20]);
     assert_eq!(summary.width, 3 * 240);
 
-    let range = parse_frame_range("10..").unwrap();
-    assert_eq!(resolve_frame_range(range, 195), 10..195);
-    assert_eq!(
-        resolve_frame_range(parse_frame_range("..5").unwrap(), 195),
-        0..5
-    );
+    let parse = |t: &str| t.parse::<FrameRange>();
+    assert_eq!(parse("10..").unwrap().resolve(195), 10..195);
+    assert_eq!(parse("..5").unwrap().resolve(195), 0..5);
+    assert_eq!(parse("3..7").unwrap(), FrameRange::new(3..7));
+    // An open end runs to the end of the take.
+    let options = RenderOptions {
+        frames: Some(parse("190..").unwrap()),
+        every: Some(2),
+        ..RenderOptions::default()
+    };
+    let summary = render(&scene, &dir.path().join("b.png"), &options).unwrap();
+    assert_eq!(summary.frames, vec![190, 192, 194]);
     for bad in ["10", "a..b", "5..5", "9..3"] {
-        let e = parse_frame_range(bad).unwrap_err().to_string();
+        let e = parse(bad).unwrap_err().to_string();
         assert!(e.contains(bad), "{e}");
     }
 }
@@ -101,7 +107,7 @@ fn bad_requests_are_clear_errors() {
     let e = render_with(
         "a.png",
         RenderOptions {
-            frames: Some(100..300),
+            frames: Some(FrameRange::new(100..300)),
             ..RenderOptions::default()
         },
     );
@@ -137,7 +143,7 @@ fn gif_has_the_frames_at_the_takes_speed() {
     let out = dir.path().join("walk.gif");
     let scene = Scene::from_files(&[sample()]).unwrap();
     let options = RenderOptions {
-        frames: Some(0..30),
+        frames: Some(FrameRange::new(0..30)),
         panel_size: Some((160, 120)),
         ..RenderOptions::default()
     };
@@ -170,7 +176,7 @@ fn side_by_side_puts_the_second_motion_to_the_right() {
     let out = dir.path().join("side.png");
     let scene = Scene::from_files(&[sample(), sample()]).unwrap();
     let options = RenderOptions {
-        frames: Some(0..1),
+        frames: Some(FrameRange::new(0..1)),
         layout: Layout::SideBySide,
         panel_size: Some((480, 320)),
         ..RenderOptions::default()
