@@ -834,9 +834,11 @@ fn gif(
     let s = SUPER as f32;
     let mut bytes = Vec::new();
     {
-        // Speed 10 of NeuQuant's 1 (best, slowest) to 30: no visible
-        // difference on flat-coloured figures, several times faster.
-        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
+        // NeuQuant's fastest setting (30; 1 is best and slowest): the
+        // figures are flat colours on a plain background, and a frame of
+        // the sample looks the same at 10 while encoding takes 1.5 times as
+        // long (see RESULTS.md).
+        let mut encoder = GifEncoder::new_with_speed(&mut bytes, 30);
         encoder
             .set_repeat(Repeat::Infinite)
             .map_err(|e| Error::Invalid(format!("GIF encoding failed: {e}")))?;
