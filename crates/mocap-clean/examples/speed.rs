@@ -1,0 +1,115 @@
+//! Inference and training speed of a denoiser (a benchmark, not a test).
+//!
+//! cargo run --release -p mocap-clean --example speed -- --data ../shared/data/bandai \
+//!     [--model FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
+//!
+//! Inference: a clip of `frames` frames (takes of the data set joined end to
+//! end), cleaned `repeats` times; frames per second of `CleanModel::clean`
+//! (feature conversion, windows, network, blending and writing the rotations
+//! back all included; file reading excluded).
+//! Training: samples per second of `train_steps` optimiser steps of the
+//! model's configuration (noise generation included).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use mocap_clean::dataset::list_bvh;
+use mocap_clean::infer::CleanModel;
+use mocap_clean::training::{train, TrainOptions};
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::Motion;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (mut data, mut model_path, mut device) = (None, None, mocap_nn::device::DeviceChoice::Cpu);
+    let (mut frames, mut repeats, mut train_steps, mut batch) =
+        (1800usize, 5usize, 5usize, 512usize);
+    let mut i = 0;
+    while i < args.len() {
+        let v = args
+            .get(i + 1)
+            .cloned()
+            .ok_or(format!("{} needs a value", args[i]))?;
+        match args[i].as_str() {
+            "--data" => data = Some(PathBuf::from(v)),
+            "--model" => model_path = Some(PathBuf::from(v)),
+            "--device" => device = v.parse()?,
+            "--frames" => frames = v.parse()?,
+            "--repeats" => repeats = v.parse()?,
+            "--train-steps" => train_steps = v.parse()?,
+            "--batch" => batch = v.parse()?,
+            other => return Err(format!("unknown option {other}").into()),
+        }
+        i += 2;
+    }
+    let data = data.ok_or("--data FOLDER is required")?;
+    let model = match &model_path {
+        Some(p) => CleanModel::load(p, device)?,
+        None => CleanModel::load_default(device)?,
+    };
+    // A long clip: takes joined end to end on the first take's skeleton.
+    let paths = list_bvh(std::slice::from_ref(&data))?;
+    let first = read_bvh(&paths[0])?;
+    let c = first.skeleton().channel_count();
+    let mut values = Vec::with_capacity(frames * c);
+    for p in &paths {
+        if values.len() >= frames * c {
+            break;
+        }
+        let m = read_bvh(p)?;
+        if m.skeleton().channel_count() == c {
+            values.extend_from_slice(m.values());
+        }
+    }
+    values.truncate(frames * c);
+    let clip = Motion::new(
+        first.skeleton().clone(),
+        first.frame_time(),
+        values.len() / c,
+        values,
+    )?;
+    model.clean(&clip, None)?; // warm-up
+    let start = Instant::now();
+    for _ in 0..repeats {
+        model.clean(&clip, None)?;
+    }
+    let seconds = start.elapsed().as_secs_f64() / repeats as f64;
+    let fps = clip.frame_count() as f64 / seconds;
+    println!(
+        "inference: {} frames in {:.4} s = {:.0} frames/s = {:.0}x real time at {:.0} fps ({} parameters, device {device})",
+        clip.frame_count(),
+        seconds,
+        fps,
+        fps / clip.fps(),
+        clip.fps(),
+        model.parameter_count()
+    );
+    if train_steps > 0 {
+        let dir = tempfile_dir()?;
+        let options = TrainOptions {
+            inputs: vec![data],
+            out: dir.join("speed.safetensors"),
+            network: model.description.network,
+            representation: model.description.representation,
+            epochs: 1,
+            steps_per_epoch: train_steps,
+            batch_size: batch,
+            validation_windows: batch,
+            device,
+            ..TrainOptions::default()
+        };
+        let report = train(&options)?;
+        println!(
+            "training: {:.0} samples/s ({} steps of batch {batch}, noise generation included, device {device})",
+            report.samples_per_second, train_steps
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Ok(())
+}
+
+fn tempfile_dir() -> std::io::Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("mocap-clean-speed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
+}

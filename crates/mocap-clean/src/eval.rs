@@ -1,0 +1,425 @@
+//! Evaluation of every method (noisy input, tuned classical filters, trained
+//! models) on clean takes with synthetic noise.
+//!
+//! Metrics, averaged over frames and joints, against the clean take:
+//! - rotation error: geodesic angle between the local joint rotations, in
+//!   degrees;
+//! - position error: mean per-joint position error after forward kinematics
+//!   (file units; centimetres for the Bandai Namco data);
+//! - acceleration error: mean norm of the difference of joint accelerations
+//!   (second finite differences of positions, units per frame^2).
+//!
+//! Classical filters are tuned per noise condition on validation takes (grid
+//! search for the lowest rotation error) and then run on the evaluation
+//! takes with those settings.
+
+use std::path::PathBuf;
+
+use mocap_core::rotation::angle_between;
+use mocap_core::{forward_kinematics, metrics, Motion};
+use mocap_nn::device::DeviceChoice;
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions, Take};
+use crate::filters::{filter_motion, Filter};
+use crate::infer::CleanModel;
+use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
+use crate::{CleanError, Result};
+
+/// Mean geodesic angle (degrees) between the local rotations of two
+/// motions on the same skeleton (`mocap_core::metrics`).
+pub fn rotation_error_deg(a: &Motion, b: &Motion) -> f64 {
+    metrics::mean_rotation_error_degrees(a, b).map_or(f64::NAN, |e| e as f64)
+}
+
+/// Mean per-joint position error and acceleration error (units per frame^2)
+/// after forward kinematics (`mocap_core::metrics`); NaN for takes too short.
+pub fn position_errors(a: &Motion, b: &Motion) -> (f64, f64) {
+    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
+    let position =
+        metrics::mean_joint_position_error(&pa, &pb, None).map_or(f64::NAN, |e| e as f64);
+    let acceleration = metrics::acceleration_error(&pa, &pb, None).map_or(f64::NAN, |e| e as f64);
+    (position, acceleration)
+}
+
+/// The metrics of one method under one noise condition.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodMetrics {
+    pub method: String,
+    pub condition: String,
+    pub rotation_error_deg: f64,
+    pub position_error: f64,
+    pub acceleration_error: f64,
+}
+
+/// A model to evaluate: a label and a file (`None`: the shipped default).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ModelEntry {
+    pub label: String,
+    pub path: Option<PathBuf>,
+}
+
+/// Options of `mocap clean eval`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EvalOptions {
+    /// Folders or files of clean BVH takes.
+    pub inputs: Vec<PathBuf>,
+    /// Evaluate only the takes of the test split (use when `inputs` is the
+    /// training data); otherwise every take is evaluated.
+    pub test_split_only: bool,
+    pub split: SplitFractions,
+    pub models: Vec<ModelEntry>,
+    /// Include the classical filters, tuned on validation takes.
+    pub filters: bool,
+    /// Validation takes used to tune the filters (from `inputs`' validation
+    /// split, or the first takes when `test_split_only` is off).
+    pub tune_takes: usize,
+    /// Evaluate at most this many takes.
+    pub max_takes: Option<usize>,
+    pub random: RandomNoise,
+    pub spikes: SpikeNoise,
+    /// Spike lengths (frames) of the spike-survival study; empty to skip.
+    pub spike_lengths: Vec<usize>,
+    pub seed: u64,
+    pub device: DeviceChoice,
+}
+
+impl Default for EvalOptions {
+    fn default() -> Self {
+        EvalOptions {
+            inputs: Vec::new(),
+            test_split_only: true,
+            split: SplitFractions::default(),
+            models: vec![ModelEntry {
+                label: "default model".into(),
+                path: None,
+            }],
+            filters: true,
+            tune_takes: 20,
+            max_takes: None,
+            random: RandomNoise::default(),
+            spikes: SpikeNoise::default(),
+            spike_lengths: vec![2, 4, 8, 16, 32, 64],
+            seed: 7,
+            device: DeviceChoice::Cpu,
+        }
+    }
+}
+
+/// The filter chosen for a condition and family.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TunedFilter {
+    pub condition: String,
+    pub filter: Filter,
+    /// Mean rotation error on the tuning takes.
+    pub tuning_rotation_error_deg: f64,
+}
+
+/// How much of a spike of a given length survives each method.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SpikeSurvival {
+    pub length: usize,
+    pub method: String,
+    /// Rotation error (degrees) on the spiked joints and frames, before.
+    pub noisy_error_deg: f64,
+    /// The same after the method.
+    pub residual_error_deg: f64,
+}
+
+/// What `mocap clean eval` reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EvalReport {
+    pub takes: usize,
+    pub frames: usize,
+    /// One entry per method and condition.
+    pub entries: Vec<MethodMetrics>,
+    pub tuned_filters: Vec<TunedFilter>,
+    pub spike_survival: Vec<SpikeSurvival>,
+}
+
+/// The noise conditions evaluated.
+pub const CONDITIONS: [&str; 2] = ["random", "spikes"];
+
+/// A deterministic generator for (take, condition).
+fn rng_for(seed: u64, take: usize, condition: usize) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(
+        seed ^ ((take as u64) << 8 | condition as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15),
+    )
+}
+
+/// The noisy copy of take `i` under `condition`: random noise alone, or
+/// spikes (from other takes) on top of random noise.
+fn make_noisy(takes: &[Take], i: usize, condition: usize, options: &EvalOptions) -> Result<Motion> {
+    let mut rng = rng_for(options.seed, i, condition);
+    let clean = &takes[i].motion;
+    let (noisy, _) = add_random_noise(clean, &options.random, &mut rng);
+    if condition == 0 {
+        return Ok(noisy);
+    }
+    let donors = donor_windows(takes, i, clean.frame_count(), &mut rng);
+    let refs: Vec<&Motion> = donors.iter().collect();
+    if refs.is_empty() {
+        return Ok(noisy);
+    }
+    Ok(add_spike_noise(&noisy, &refs, &options.spikes, &mut rng)?.0)
+}
+
+/// Donor motions as long as `frames` from other takes (looped when shorter).
+fn donor_windows(takes: &[Take], skip: usize, frames: usize, rng: &mut ChaCha8Rng) -> Vec<Motion> {
+    let mut out = Vec::new();
+    if takes.len() < 2 {
+        return out;
+    }
+    for _ in 0..3 {
+        let mut d = rng.random_range(0..takes.len());
+        if d == skip {
+            d = (d + 1) % takes.len();
+        }
+        let m = &takes[d].motion;
+        if m.skeleton().joint_count() != takes[skip].motion.skeleton().joint_count()
+            || m.frame_count() == 0
+        {
+            continue;
+        }
+        let c = m.skeleton().channel_count();
+        let mut values = Vec::with_capacity(frames * c);
+        for f in 0..frames {
+            values.extend_from_slice(m.frame(f % m.frame_count()));
+        }
+        out.push(Motion::new(m.skeleton().clone(), m.frame_time(), frames, values).expect("valid"));
+    }
+    out
+}
+
+fn tune(
+    takes: &[Take],
+    condition: usize,
+    family: &str,
+    options: &EvalOptions,
+) -> Result<TunedFilter> {
+    let noisy: Vec<Motion> = (0..takes.len())
+        .map(|i| make_noisy(takes, i, condition, options))
+        .collect::<Result<_>>()?;
+    let mut best: Option<(f64, Filter)> = None;
+    for filter in Filter::tuning_grid(family) {
+        let mut sum = 0.0;
+        for (take, n) in takes.iter().zip(&noisy) {
+            sum += rotation_error_deg(&take.motion, &filter_motion(n, &filter)?);
+        }
+        let mean = sum / takes.len().max(1) as f64;
+        if best.is_none_or(|(b, _)| mean < b) {
+            best = Some((mean, filter));
+        }
+    }
+    let (error, filter) =
+        best.ok_or_else(|| CleanError::Invalid(format!("no settings for `{family}`")))?;
+    Ok(TunedFilter {
+        condition: CONDITIONS[condition].into(),
+        filter,
+        tuning_rotation_error_deg: error,
+    })
+}
+
+enum Cleaner {
+    Filter(Filter),
+    Model(Box<CleanModel>),
+}
+
+impl Cleaner {
+    fn run(&self, noisy: &Motion) -> Result<Motion> {
+        match self {
+            Cleaner::Filter(f) => filter_motion(noisy, f),
+            Cleaner::Model(m) => m.clean(noisy, None),
+        }
+    }
+}
+
+/// Runs the evaluation.
+pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
+    let paths = list_bvh(&options.inputs)?;
+    let (mut eval_paths, tune_paths) = if options.test_split_only {
+        (
+            paths_in_split(&paths, Split::Test, &options.split),
+            paths_in_split(&paths, Split::Validation, &options.split),
+        )
+    } else {
+        (paths.clone(), paths.clone())
+    };
+    if let Some(max) = options.max_takes {
+        eval_paths.truncate(max);
+    }
+    if eval_paths.is_empty() {
+        return Err(CleanError::Invalid(
+            "no takes to evaluate (is the test split empty?)".into(),
+        ));
+    }
+    let takes = load_takes(&eval_paths)?;
+    let mut models = Vec::new();
+    for m in &options.models {
+        let model = match &m.path {
+            Some(p) => CleanModel::load(p, options.device)?,
+            None => CleanModel::load_default(options.device)?,
+        };
+        models.push((m.label.clone(), Cleaner::Model(Box::new(model))));
+    }
+    let mut tuned_filters = Vec::new();
+    let mut per_condition: Vec<Vec<(String, Cleaner)>> = Vec::new();
+    let tune_takes = if options.filters {
+        load_takes(&tune_paths[..options.tune_takes.min(tune_paths.len())])?
+    } else {
+        Vec::new()
+    };
+    for condition in 0..CONDITIONS.len() {
+        let mut cleaners = Vec::new();
+        if options.filters && tune_takes.len() >= 2 {
+            for family in Filter::FAMILIES {
+                let t = tune(&tune_takes, condition, family, options)?;
+                cleaners.push((t.filter.label(), Cleaner::Filter(t.filter)));
+                tuned_filters.push(t);
+            }
+        }
+        per_condition.push(cleaners);
+    }
+
+    let mut entries = Vec::new();
+    for (condition, filters) in per_condition.iter().enumerate() {
+        let methods: Vec<(&str, &Cleaner)> = filters
+            .iter()
+            .chain(models.iter())
+            .map(|(l, c)| (l.as_str(), c))
+            .collect();
+        let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
+        let mut frames_total = 0usize;
+        for i in 0..takes.len() {
+            let clean = &takes[i].motion;
+            let noisy = make_noisy(&takes, i, condition, options)?;
+            let w = clean.frame_count() as f64;
+            frames_total += clean.frame_count();
+            let mut add = |slot: usize, m: &Motion| {
+                let r = rotation_error_deg(clean, m);
+                let (p, a) = position_errors(clean, m);
+                sums[slot][0] += r * w;
+                sums[slot][1] += p * w;
+                sums[slot][2] += a * w;
+            };
+            add(0, &noisy);
+            for (k, (_, cleaner)) in methods.iter().enumerate() {
+                add(k + 1, &cleaner.run(&noisy)?);
+            }
+        }
+        let names = std::iter::once("noisy input").chain(methods.iter().map(|(l, _)| *l));
+        for (name, s) in names.zip(&sums) {
+            let n = frames_total.max(1) as f64;
+            entries.push(MethodMetrics {
+                method: name.to_string(),
+                condition: CONDITIONS[condition].into(),
+                rotation_error_deg: s[0] / n,
+                position_error: s[1] / n,
+                acceleration_error: s[2] / n,
+            });
+        }
+    }
+
+    // Spike survival: one spike of each length in the middle of each take
+    // (no random noise), error measured on the spiked joints and frames.
+    let mut spike_survival = Vec::new();
+    let spike_methods: Vec<(&str, &Cleaner)> = per_condition
+        .get(1)
+        .into_iter()
+        .flatten()
+        .chain(models.iter())
+        .map(|(l, c)| (l.as_str(), c))
+        .collect();
+    for &length in &options.spike_lengths {
+        let mut noisy_sum = 0.0;
+        let mut residual = vec![0.0; spike_methods.len()];
+        let mut count = 0usize;
+        for i in 0..takes.len() {
+            let clean = &takes[i].motion;
+            if clean.frame_count() < length + 8 {
+                continue;
+            }
+            let mut rng = rng_for(options.seed, i, 100 + length);
+            let donors = donor_windows(&takes, i, clean.frame_count(), &mut rng);
+            let refs: Vec<&Motion> = donors.iter().collect();
+            if refs.is_empty() {
+                continue;
+            }
+            let mut spikes = [Spike {
+                joint: 0,
+                start: (clean.frame_count() - length) / 2,
+                frames: length,
+            }];
+            let (noisy, spikes) = add_spikes(clean, &refs, &options.spikes, &mut spikes, &mut rng)?;
+            let s = spikes[0];
+            let region = |m: &Motion| {
+                let joints = clean.skeleton().subtree(s.joint);
+                let mut e = 0.0;
+                for f in s.start..s.start + s.frames {
+                    for &j in &joints {
+                        e += angle_between(clean.local_rotation(f, j), m.local_rotation(f, j))
+                            .to_degrees() as f64;
+                    }
+                }
+                e / (s.frames * joints.len()) as f64
+            };
+            noisy_sum += region(&noisy);
+            for (k, (_, cleaner)) in spike_methods.iter().enumerate() {
+                residual[k] += region(&cleaner.run(&noisy)?);
+            }
+            count += 1;
+        }
+        if count == 0 {
+            continue;
+        }
+        for (k, (label, _)) in spike_methods.iter().enumerate() {
+            spike_survival.push(SpikeSurvival {
+                length,
+                method: label.to_string(),
+                noisy_error_deg: noisy_sum / count as f64,
+                residual_error_deg: residual[k] / count as f64,
+            });
+        }
+    }
+
+    Ok(EvalReport {
+        takes: takes.len(),
+        frames: takes.iter().map(|t| t.motion.frame_count()).sum(),
+        entries,
+        tuned_filters,
+        spike_survival,
+    })
+}
+
+impl EvalReport {
+    /// The report as Markdown tables.
+    pub fn to_markdown(&self) -> String {
+        let mut s = format!("{} takes, {} frames.\n\n", self.takes, self.frames);
+        for condition in CONDITIONS {
+            s += &format!("### Noise: {condition}\n\n| method | rotation error (deg) | position error (cm) | acceleration error (cm/frame^2) |\n| --- | ---: | ---: | ---: |\n");
+            for e in self.entries.iter().filter(|e| e.condition == condition) {
+                s += &format!(
+                    "| {} | {:.3} | {:.3} | {:.4} |\n",
+                    e.method, e.rotation_error_deg, e.position_error, e.acceleration_error
+                );
+            }
+            s += "\n";
+        }
+        if !self.spike_survival.is_empty() {
+            s += "### Spike survival (one spike of the given length, no random noise; error on the spiked joints and frames, degrees)\n\n| length (frames) | method | before | after | surviving |\n| ---: | --- | ---: | ---: | ---: |\n";
+            for r in &self.spike_survival {
+                s += &format!(
+                    "| {} | {} | {:.2} | {:.2} | {:.0}% |\n",
+                    r.length,
+                    r.method,
+                    r.noisy_error_deg,
+                    r.residual_error_deg,
+                    100.0 * r.residual_error_deg / r.noisy_error_deg.max(1e-9)
+                );
+            }
+        }
+        s
+    }
+}

@@ -1,0 +1,411 @@
+//! Classical baselines, for comparison and for users without a model.
+//!
+//! Each filter runs on every feature channel of the continuous 6D rotation
+//! representation (no wrap-around at +-180 degrees), and the filtered
+//! features are turned back into rotations (Gram-Schmidt), so the output has
+//! the input's skeleton and channel layout. Root translation is kept.
+//!
+//! - [`Filter::Butterworth`]: zero-phase low-pass (forward-backward
+//!   second-order sections, `sci-rs`'s port of SciPy's `butter` +
+//!   `sosfiltfilt`);
+//! - [`Filter::SavitzkyGolay`]: local polynomial least squares (coefficients
+//!   from `sci-rs`'s `savgol_coeffs`, edges padded with the nearest frame);
+//! - [`Filter::Median`]: running median, the classical remedy for spikes;
+//! - [`Filter::OneEuro`]: the One Euro filter (Casiez, Roussel, Vogel,
+//!   CHI 2012), a causal low-pass whose cutoff rises with speed.
+
+use mocap_core::Motion;
+use sci_rs::signal::filter::design::{butter_dyn, DigitalFilter, FilterBandType, FilterOutputType};
+use sci_rs::signal::filter::{savgol_coeffs_dyn, sosfiltfilt_dyn};
+use serde::{Deserialize, Serialize};
+
+use crate::features::{FeatureLayout, Representation};
+use crate::{CleanError, Result};
+
+/// A classical filter and its settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Filter {
+    /// Zero-phase Butterworth low-pass of `order` (applied forward and
+    /// backward, so the effective order doubles) with cutoff in Hz.
+    Butterworth { order: usize, cutoff_hz: f32 },
+    /// Savitzky-Golay smoothing over an odd `window` of frames with a
+    /// polynomial of degree `polyorder`.
+    SavitzkyGolay { window: usize, polyorder: usize },
+    /// Running median over an odd `window` of frames.
+    Median { window: usize },
+    /// One Euro filter: minimum cutoff (Hz), speed coefficient, and cutoff of
+    /// the speed estimate (Hz).
+    OneEuro {
+        min_cutoff_hz: f32,
+        beta: f32,
+        d_cutoff_hz: f32,
+    },
+}
+
+impl Filter {
+    /// Short name with settings, e.g. `butterworth(order=2, cutoff=6Hz)`.
+    pub fn label(&self) -> String {
+        match *self {
+            Filter::Butterworth { order, cutoff_hz } => {
+                format!("butterworth(order={order}, cutoff={cutoff_hz}Hz)")
+            }
+            Filter::SavitzkyGolay { window, polyorder } => {
+                format!("savitzky-golay(window={window}, polyorder={polyorder})")
+            }
+            Filter::Median { window } => format!("median(window={window})"),
+            Filter::OneEuro {
+                min_cutoff_hz,
+                beta,
+                d_cutoff_hz,
+            } => format!(
+                "one-euro(min_cutoff={min_cutoff_hz}Hz, beta={beta}, d_cutoff={d_cutoff_hz}Hz)"
+            ),
+        }
+    }
+
+    /// The family name (`butterworth`, `savitzky-golay`, `median`, `one-euro`).
+    pub fn family(&self) -> &'static str {
+        match self {
+            Filter::Butterworth { .. } => "butterworth",
+            Filter::SavitzkyGolay { .. } => "savitzky-golay",
+            Filter::Median { .. } => "median",
+            Filter::OneEuro { .. } => "one-euro",
+        }
+    }
+
+    /// Checks the settings against the frame rate.
+    pub fn validate(&self, fps: f32) -> Result<()> {
+        let bad = |m: String| Err(CleanError::Invalid(format!("{}: {m}", self.label())));
+        match *self {
+            Filter::Butterworth { order, cutoff_hz } => {
+                if !(1..=8).contains(&order) {
+                    return bad("order must be 1 to 8".into());
+                }
+                if !(cutoff_hz > 0.0 && cutoff_hz < 0.5 * fps) {
+                    return bad(format!(
+                        "cutoff must be between 0 and the Nyquist frequency {} Hz",
+                        0.5 * fps
+                    ));
+                }
+            }
+            Filter::SavitzkyGolay { window, polyorder } => {
+                if window.is_multiple_of(2) || window < polyorder + 2 {
+                    return bad("window must be odd and at least polyorder + 2".into());
+                }
+            }
+            Filter::Median { window } => {
+                if window.is_multiple_of(2) {
+                    return bad("window must be odd".into());
+                }
+            }
+            Filter::OneEuro {
+                min_cutoff_hz,
+                beta,
+                d_cutoff_hz,
+            } => {
+                if !(min_cutoff_hz > 0.0 && d_cutoff_hz > 0.0 && beta >= 0.0) {
+                    return bad("cutoffs must be positive and beta non-negative".into());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Filters one channel sampled at `fps` in place.
+    pub fn apply_track(&self, track: &mut [f32], fps: f32) {
+        match *self {
+            Filter::Butterworth { order, cutoff_hz } => butterworth(track, order, cutoff_hz, fps),
+            Filter::SavitzkyGolay { window, polyorder } => savitzky_golay(track, window, polyorder),
+            Filter::Median { window } => median(track, window),
+            Filter::OneEuro {
+                min_cutoff_hz,
+                beta,
+                d_cutoff_hz,
+            } => one_euro(track, min_cutoff_hz, beta, d_cutoff_hz, fps),
+        }
+    }
+
+    /// The settings tried when tuning a family on validation data.
+    pub fn tuning_grid(family: &str) -> Vec<Filter> {
+        match family {
+            "butterworth" => [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0]
+                .into_iter()
+                .flat_map(|c| {
+                    [2, 4].map(|o| Filter::Butterworth {
+                        order: o,
+                        cutoff_hz: c,
+                    })
+                })
+                .collect(),
+            "savitzky-golay" => [5, 7, 9, 11, 15, 21, 31]
+                .into_iter()
+                .flat_map(|w| {
+                    [2, 3].map(move |p| Filter::SavitzkyGolay {
+                        window: w,
+                        polyorder: p,
+                    })
+                })
+                .collect(),
+            "median" => [3, 5, 7, 9, 11, 15, 21, 31, 45]
+                .map(|w| Filter::Median { window: w })
+                .to_vec(),
+            "one-euro" => [0.3, 0.6, 1.0, 2.0, 4.0]
+                .into_iter()
+                .flat_map(|m| {
+                    [0.0, 0.05, 0.3, 1.0].map(|b| Filter::OneEuro {
+                        min_cutoff_hz: m,
+                        beta: b,
+                        d_cutoff_hz: 1.0,
+                    })
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Every family name.
+    pub const FAMILIES: [&'static str; 4] = ["butterworth", "savitzky-golay", "median", "one-euro"];
+}
+
+/// Filters the joint rotations of `motion` (see the module docs).
+pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
+    let fps = motion.fps() as f32;
+    filter.validate(fps)?;
+    let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
+    let c = layout.channels();
+    let frames = motion.frame_count();
+    let mut features = layout.encode(motion);
+    let mut track = vec![0.0; frames];
+    for ch in 0..c {
+        for f in 0..frames {
+            track[f] = features[f * c + ch];
+        }
+        filter.apply_track(&mut track, fps);
+        for f in 0..frames {
+            features[f * c + ch] = track[f];
+        }
+    }
+    let mut out = motion.clone();
+    layout.decode_into(&features, &mut out);
+    Ok(out)
+}
+
+fn butterworth(track: &mut [f32], order: usize, cutoff_hz: f32, fps: f32) {
+    let filter = butter_dyn::<f64>(
+        order,
+        vec![cutoff_hz as f64],
+        Some(FilterBandType::Lowpass),
+        Some(false),
+        Some(FilterOutputType::Sos),
+        Some(fps as f64),
+    );
+    let DigitalFilter::Sos(sos) = filter else {
+        unreachable!("asked for second-order sections")
+    };
+    // sosfiltfilt pads both ends by 3 * (2 * sections + 1) frames by odd
+    // reflection and needs a longer signal; shorter takes are left as they are.
+    let pad = 3 * (2 * sos.sos.len() + 1);
+    if track.len() <= pad {
+        return;
+    }
+    let out = sosfiltfilt_dyn(track.iter().map(|&v| v as f64), &sos.sos);
+    for (t, v) in track.iter_mut().zip(out) {
+        *t = v as f32;
+    }
+}
+
+fn savitzky_golay(track: &mut [f32], window: usize, polyorder: usize) {
+    if track.len() < 2 {
+        return;
+    }
+    let coeffs: Vec<f64> = savgol_coeffs_dyn::<f64>(window, polyorder, None, None)
+        .into_iter()
+        .collect();
+    let half = (window / 2) as isize;
+    let n = track.len() as isize;
+    let input: Vec<f64> = track.iter().map(|&v| v as f64).collect();
+    for i in 0..n {
+        // Smoothing coefficients are symmetric, so convolution and
+        // correlation agree; edges take the nearest frame.
+        let mut acc = 0.0;
+        for (k, c) in coeffs.iter().enumerate() {
+            let idx = (i + k as isize - half).clamp(0, n - 1);
+            acc += c * input[idx as usize];
+        }
+        track[i as usize] = acc as f32;
+    }
+}
+
+fn median(track: &mut [f32], window: usize) {
+    let half = window / 2;
+    let n = track.len();
+    if n == 0 || half == 0 {
+        return;
+    }
+    let input = track.to_vec();
+    let mut buf = Vec::with_capacity(window);
+    for (i, out) in track.iter_mut().enumerate() {
+        buf.clear();
+        for k in 0..window {
+            // Nearest-frame padding at the edges.
+            let idx = (i + k).saturating_sub(half).min(n - 1);
+            buf.push(input[idx]);
+        }
+        buf.sort_by(f32::total_cmp);
+        *out = buf[half];
+    }
+}
+
+/// Smoothing factor of an exponential low-pass with cutoff `fc` at `fps`
+/// (Casiez et al. 2012, eq. for alpha: `1 / (1 + tau / Te)`, `tau = 1 / (2 pi fc)`).
+fn smoothing_factor(fc: f32, fps: f32) -> f32 {
+    let tau = 1.0 / (2.0 * std::f32::consts::PI * fc);
+    1.0 / (1.0 + tau * fps)
+}
+
+fn one_euro(track: &mut [f32], min_cutoff: f32, beta: f32, d_cutoff: f32, fps: f32) {
+    if track.is_empty() {
+        return;
+    }
+    let mut x_hat = track[0];
+    let mut dx_hat = 0.0;
+    let a_d = smoothing_factor(d_cutoff, fps);
+    for v in track.iter_mut().skip(1) {
+        let dx = (*v - x_hat) * fps;
+        dx_hat += a_d * (dx - dx_hat);
+        let cutoff = min_cutoff + beta * dx_hat.abs();
+        x_hat += smoothing_factor(cutoff, fps) * (*v - x_hat);
+        *v = x_hat;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noisy_sine(n: usize) -> (Vec<f32>, Vec<f32>) {
+        let clean: Vec<f32> = (0..n).map(|i| (i as f32 / 30.0 * 2.0).sin()).collect();
+        // Deterministic high-frequency "noise": alternating sign.
+        let noisy = clean
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + if i % 2 == 0 { 0.1 } else { -0.1 })
+            .collect();
+        (clean, noisy)
+    }
+
+    fn rms(a: &[f32], b: &[f32]) -> f32 {
+        (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>() / a.len() as f32).sqrt()
+    }
+
+    #[test]
+    fn every_filter_removes_high_frequency_noise() {
+        let (clean, noisy) = noisy_sine(300);
+        let before = rms(&clean, &noisy);
+        for filter in [
+            Filter::Butterworth {
+                order: 2,
+                cutoff_hz: 3.0,
+            },
+            Filter::SavitzkyGolay {
+                window: 9,
+                polyorder: 2,
+            },
+            Filter::Median { window: 5 },
+            Filter::OneEuro {
+                min_cutoff_hz: 4.0,
+                beta: 0.0,
+                d_cutoff_hz: 1.0,
+            },
+        ] {
+            filter.validate(30.0).unwrap();
+            let mut track = noisy.clone();
+            filter.apply_track(&mut track, 30.0);
+            let after = rms(&clean, &track);
+            // One Euro is causal: it lags, so it removes less.
+            let bound = if filter.family() == "one-euro" {
+                0.75
+            } else {
+                0.5
+            };
+            assert!(
+                after < bound * before,
+                "{}: {before} -> {after}",
+                filter.label()
+            );
+        }
+    }
+
+    #[test]
+    fn zero_phase_filters_keep_a_line_in_place() {
+        // A straight line has no delay under a zero-phase or polynomial filter.
+        let line: Vec<f32> = (0..200).map(|i| 0.01 * i as f32).collect();
+        for filter in [
+            Filter::Butterworth {
+                order: 2,
+                cutoff_hz: 3.0,
+            },
+            Filter::SavitzkyGolay {
+                window: 11,
+                polyorder: 2,
+            },
+            Filter::Median { window: 5 },
+        ] {
+            let mut track = line.clone();
+            filter.apply_track(&mut track, 30.0);
+            for i in 20..180 {
+                assert!(
+                    (track[i] - line[i]).abs() < 1e-3,
+                    "{} at {i}",
+                    filter.label()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn median_removes_a_short_spike() {
+        let mut track = vec![1.0f32; 50];
+        for v in &mut track[20..23] {
+            *v = 9.0;
+        }
+        Filter::Median { window: 9 }.apply_track(&mut track, 30.0);
+        assert!(track.iter().all(|&v| v == 1.0));
+    }
+
+    #[test]
+    fn bad_settings_are_errors() {
+        assert!(Filter::Butterworth {
+            order: 2,
+            cutoff_hz: 20.0
+        }
+        .validate(30.0)
+        .is_err());
+        assert!(Filter::SavitzkyGolay {
+            window: 4,
+            polyorder: 2
+        }
+        .validate(30.0)
+        .is_err());
+        assert!(Filter::Median { window: 4 }.validate(30.0).is_err());
+    }
+
+    #[test]
+    fn filtering_a_motion_keeps_layout_and_root_translation() {
+        let motion = crate::test_support::synthetic_motion(90, 5);
+        let out = filter_motion(
+            &motion,
+            &Filter::Butterworth {
+                order: 2,
+                cutoff_hz: 6.0,
+            },
+        )
+        .unwrap();
+        assert_eq!(out.skeleton(), motion.skeleton());
+        assert_eq!(out.frame_count(), motion.frame_count());
+        for f in 0..90 {
+            assert_eq!(out.root_translation(f), motion.root_translation(f));
+        }
+    }
+}

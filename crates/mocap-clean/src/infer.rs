@@ -1,0 +1,356 @@
+//! Cleaning whole takes with a trained denoiser.
+//!
+//! A take of any length is cut into overlapping windows of the model's
+//! length `T`, every `hop` frames (default `T / 4`). Each window's output is
+//! weighted by `w(t) = sin^2(pi (t + 1/2) / T)`, which is largest in the
+//! window's middle and small at its borders, and the weighted outputs are
+//! summed and divided by the summed weights. A frame thus gets a smooth mix
+//! of the windows that see it well, with no seam where a window ends. The
+//! take is padded by repeating its first and last frames so that its own
+//! first and last frames are in the middle of some window.
+//!
+//! Only rotations change: the output has the input's skeleton, channel
+//! layout and root translation.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use burn::module::Module;
+use burn::tensor::{Device, Tensor, TensorData};
+use mocap_core::io::bvh::{read_bvh, write_bvh};
+use mocap_core::Motion;
+use mocap_nn::checkpoint::{header_from_bytes, load_weights_from_bytes};
+use mocap_nn::device::DeviceChoice;
+use serde::{Deserialize, Serialize};
+
+use crate::features::FeatureLayout;
+use crate::filters::{filter_motion, Filter};
+use crate::model::Denoiser;
+use crate::training::{ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
+use crate::{CleanError, Result};
+
+/// Where the shipped default model lives in the source tree.
+pub const DEFAULT_MODEL_PATH: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../models/clean-default.safetensors"
+);
+
+/// A trained denoiser ready to clean takes.
+pub struct CleanModel {
+    pub description: ModelDescription,
+    /// Where it was loaded from.
+    pub source: PathBuf,
+    model: Denoiser,
+    device: Device,
+}
+
+impl std::fmt::Debug for CleanModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CleanModel")
+            .field("description", &self.description)
+            .field("source", &self.source)
+            .finish_non_exhaustive()
+    }
+}
+
+impl CleanModel {
+    /// Loads a model file written by training.
+    pub fn load(path: &Path, device: DeviceChoice) -> Result<CleanModel> {
+        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+        Self::from_bytes(bytes, path, device)
+    }
+
+    /// The shipped default model (`models/clean-default.safetensors`), or
+    /// the file named by the `MOCAP_CLEAN_MODEL` environment variable.
+    pub fn load_default(device: DeviceChoice) -> Result<CleanModel> {
+        let path = std::env::var_os("MOCAP_CLEAN_MODEL")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL_PATH));
+        if !path.is_file() {
+            return Err(CleanError::Invalid(format!(
+                "{}: the default model is missing; pass a model with --model or use a classical filter",
+                path.display()
+            )));
+        }
+        Self::load(&path, device)
+    }
+
+    /// Loads checkpoint bytes; `origin` names them in errors.
+    pub fn from_bytes(bytes: Vec<u8>, origin: &Path, device: DeviceChoice) -> Result<CleanModel> {
+        let header = header_from_bytes(&bytes, origin)?;
+        let bad = |m: String| CleanError::Invalid(format!("{}: {m}", origin.display()));
+        if header.kind != CHECKPOINT_KIND {
+            return Err(bad(format!(
+                "a `{}` model, expected `{CHECKPOINT_KIND}`",
+                header.kind
+            )));
+        }
+        if header.kind_version != CHECKPOINT_KIND_VERSION {
+            return Err(bad(format!(
+                "model description version {}, this build reads {CHECKPOINT_KIND_VERSION}",
+                header.kind_version
+            )));
+        }
+        let description: ModelDescription = serde_json::from_value(header.config)
+            .map_err(|e| bad(format!("bad model description: {e}")))?;
+        let device = device.device()?;
+        let model = description.network.init(&device)?;
+        let model = load_weights_from_bytes(bytes, origin, model)?;
+        Ok(CleanModel {
+            description,
+            source: origin.to_path_buf(),
+            model,
+            device,
+        })
+    }
+
+    /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
+    pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
+        let layout = FeatureLayout::new(motion.skeleton(), self.description.representation)?;
+        let c = layout.channels();
+        if c != self.description.network.channels {
+            return Err(CleanError::Invalid(format!(
+                "the model expects {} rotation features ({} joints), the take has {c} ({} joints with rotations)",
+                self.description.network.channels,
+                self.description.joints.len(),
+                layout.joints.len()
+            )));
+        }
+        let t = self.description.network.window;
+        let hop = hop.unwrap_or(t / 4).clamp(1, t);
+        let frames = motion.frame_count();
+        if frames == 0 {
+            return Ok(motion.clone());
+        }
+        let features = layout.encode(motion);
+        // Pad by repeating the edge frames: half a window in front, and at
+        // the end enough for the last window to be whole.
+        let front = t / 2;
+        let windows = (frames + front).div_ceil(hop).max(1);
+        let padded_len = (windows - 1) * hop + t;
+        let mut padded = Vec::with_capacity(padded_len * c);
+        for i in 0..padded_len {
+            let f = (i as isize - front as isize).clamp(0, frames as isize - 1) as usize;
+            padded.extend_from_slice(&features[f * c..(f + 1) * c]);
+        }
+        let weight: Vec<f32> = (0..t)
+            .map(|k| {
+                (std::f32::consts::PI * (k as f32 + 0.5) / t as f32)
+                    .sin()
+                    .powi(2)
+            })
+            .collect();
+        let mut sum = vec![0.0f32; padded_len * c];
+        let mut weight_sum = vec![0.0f32; padded_len];
+        let batch = 256;
+        let mut start_index = 0;
+        while start_index < windows {
+            let n = batch.min(windows - start_index);
+            let mut x = vec![0.0; n * c * t];
+            let mut offsets = Vec::with_capacity(n);
+            for b in 0..n {
+                let s = (start_index + b) * hop;
+                let mut w = padded[s * c..(s + t) * c].to_vec();
+                offsets.push(layout.recenter(&mut w));
+                for f in 0..t {
+                    for ch in 0..c {
+                        x[(b * c + ch) * t + f] = w[f * c + ch];
+                    }
+                }
+            }
+            let input = Tensor::<3>::from_data(TensorData::new(x, [n, c, t]), &self.device);
+            let output = self.model.forward(input).into_data();
+            let y: Vec<f32> = output
+                .try_to_vec()
+                .map_err(|e| CleanError::Invalid(format!("reading the network output: {e:?}")))?;
+            for (b, offset) in offsets.iter().enumerate() {
+                let s = (start_index + b) * hop;
+                for f in 0..t {
+                    let w = weight[f];
+                    weight_sum[s + f] += w;
+                    for ch in 0..c {
+                        sum[(s + f) * c + ch] += w * (y[(b * c + ch) * t + f] + offset[ch]);
+                    }
+                }
+            }
+            start_index += n;
+        }
+        let mut cleaned = vec![0.0; frames * c];
+        for f in 0..frames {
+            let p = f + front;
+            for ch in 0..c {
+                cleaned[f * c + ch] = sum[p * c + ch] / weight_sum[p];
+            }
+        }
+        let mut out = motion.clone();
+        layout.decode_into(&cleaned, &mut out);
+        Ok(out)
+    }
+
+    /// Number of trainable numbers of the network.
+    pub fn parameter_count(&self) -> usize {
+        self.model.num_params()
+    }
+}
+
+/// How `mocap clean IN -o OUT` cleans.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub enum Method {
+    /// The shipped default model.
+    DefaultModel,
+    /// A model file.
+    Model(PathBuf),
+    /// A classical filter instead of a model.
+    Filter(Filter),
+}
+
+/// Options of `mocap clean IN -o OUT`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CleanOptions {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub method: Method,
+    pub device: DeviceChoice,
+    /// Frames between window starts (default: a quarter window).
+    pub hop: Option<usize>,
+}
+
+/// What `mocap clean IN -o OUT` reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CleanReport {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub method: String,
+    pub frames: usize,
+    pub seconds: f64,
+    /// Frames cleaned per second (reading and writing excluded).
+    pub frames_per_second: f64,
+    /// Mean change of the joint rotations, in degrees.
+    pub mean_change_deg: f64,
+}
+
+/// Reads a take, cleans it and writes it (atomically).
+pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
+    let motion = read_bvh(&options.input)?;
+    let (cleaned, method, seconds) = match &options.method {
+        Method::Filter(filter) => {
+            let start = Instant::now();
+            let out = filter_motion(&motion, filter)?;
+            (out, filter.label(), start.elapsed().as_secs_f64())
+        }
+        m => {
+            let model = match m {
+                Method::Model(path) => CleanModel::load(path, options.device)?,
+                _ => CleanModel::load_default(options.device)?,
+            };
+            let start = Instant::now();
+            let out = model.clean(&motion, options.hop)?;
+            (
+                out,
+                format!("model {}", model.source.display()),
+                start.elapsed().as_secs_f64(),
+            )
+        }
+    };
+    write_bvh(&options.output, &cleaned)?;
+    let frames = motion.frame_count();
+    Ok(CleanReport {
+        input: options.input.clone(),
+        output: options.output.clone(),
+        method,
+        frames,
+        seconds,
+        frames_per_second: frames as f64 / seconds.max(1e-9),
+        mean_change_deg: crate::eval::rotation_error_deg(&motion, &cleaned),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::Representation;
+    use crate::model::DenoiserConfig;
+    use crate::test_support::synthetic_motion;
+    use mocap_nn::checkpoint::{weights_to_bytes, CheckpointHeader};
+
+    fn model_bytes(representation: Representation, joints: usize) -> Vec<u8> {
+        let device = Device::flex();
+        device.seed(5);
+        let mut network = DenoiserConfig::small(joints * representation.dim());
+        network.width = 8;
+        let model = network.init(&device).unwrap();
+        let description = ModelDescription {
+            network,
+            representation,
+            joints: (0..joints).map(|j| format!("j{j}")).collect(),
+            fps: 30.0,
+        };
+        let header = CheckpointHeader {
+            kind: CHECKPOINT_KIND.into(),
+            kind_version: CHECKPOINT_KIND_VERSION,
+            config: serde_json::to_value(&description).unwrap(),
+            data: serde_json::Value::Null,
+            training: serde_json::Value::Null,
+        };
+        weights_to_bytes(&model, &header).unwrap()
+    }
+
+    #[test]
+    fn cleans_takes_of_any_length_and_keeps_the_layout() {
+        let bytes = model_bytes(Representation::Rot6d, 5);
+        let model = CleanModel::from_bytes(bytes, Path::new("test.safetensors"), DeviceChoice::Cpu)
+            .unwrap();
+        for frames in [1, 7, 16, 33, 100] {
+            let motion = synthetic_motion(frames, 5);
+            let out = model.clean(&motion, None).unwrap();
+            assert_eq!(out.frame_count(), frames);
+            assert_eq!(out.skeleton(), motion.skeleton());
+            for f in 0..frames {
+                assert_eq!(out.root_translation(f), motion.root_translation(f));
+            }
+        }
+    }
+
+    #[test]
+    fn the_blend_has_no_seams() {
+        // The output of overlapping windows is a weighted mean; changing the
+        // hop moves the window borders, and with smooth weights the result
+        // must stay close (an unweighted cut would jump at borders).
+        let bytes = model_bytes(Representation::Rot6d, 5);
+        let model = CleanModel::from_bytes(bytes, Path::new("t"), DeviceChoice::Cpu).unwrap();
+        let motion = synthetic_motion(120, 5);
+        let a = model.clean(&motion, Some(4)).unwrap();
+        let b = model.clean(&motion, Some(2)).unwrap();
+        let diff = crate::eval::rotation_error_deg(&a, &b);
+        let change = crate::eval::rotation_error_deg(&motion, &a);
+        assert!(
+            diff < 0.25 * change.max(0.1),
+            "hop changes the result by {diff} (model changes {change})"
+        );
+    }
+
+    #[test]
+    fn checkpoints_round_trip_and_reject_other_files() {
+        let bytes = model_bytes(Representation::Euler, 5);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.safetensors");
+        std::fs::write(&path, &bytes).unwrap();
+        let a = CleanModel::load(&path, DeviceChoice::Cpu).unwrap();
+        let b = CleanModel::from_bytes(bytes.clone(), &path, DeviceChoice::Cpu).unwrap();
+        let motion = synthetic_motion(40, 5);
+        assert_eq!(
+            a.clean(&motion, None).unwrap().values(),
+            b.clean(&motion, None).unwrap().values()
+        );
+        assert_eq!(a.description.representation, Representation::Euler);
+        // A file that is not a checkpoint is an error naming it.
+        std::fs::write(&path, b"not a model").unwrap();
+        let e = CleanModel::load(&path, DeviceChoice::Cpu)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.safetensors"), "{e}");
+        // A model for another skeleton is an error, not a panic.
+        let other = synthetic_motion(20, 7);
+        assert!(a.clean(&other, None).is_err());
+    }
+}

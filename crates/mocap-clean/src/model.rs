@@ -1,0 +1,234 @@
+//! The denoiser: a 1-D convolutional autoencoder over time.
+//!
+//! The input is a window `[batch, channels, frames]` of joint-rotation
+//! features; convolutions run along time only, every joint's features being
+//! channels (so nothing is down-sampled across joints). The network is a
+//! U-shaped residual encoder-decoder:
+//!
+//! ```text
+//! x ─ conv ─ [res blocks ─ down (stride 2)] x levels ─ res blocks ─┐
+//!                 │ skip (same size)                               │
+//!             [up (transposed, stride 2) + skip ─ res blocks] x levels
+//!                                      ─ conv ─ + x  (global skip)
+//! ```
+//!
+//! Residual blocks are `relu(x + conv(relu(conv(x))))`. The global skip makes
+//! the network predict a correction to its input, which is small for random
+//! noise. Every skip connection adds tensors of the same size.
+
+use burn::module::Module;
+use burn::nn::conv::{Conv1d, Conv1dConfig, ConvTranspose1d, ConvTranspose1dConfig};
+use burn::nn::PaddingConfig1d;
+use burn::tensor::activation::relu;
+use burn::tensor::{Device, Tensor};
+use serde::{Deserialize, Serialize};
+
+use crate::{CleanError, Result};
+
+/// Sizes of the network. The defaults are the small CPU setting;
+/// [`DenoiserConfig::large`] is the report's deeper, wider setting for a GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DenoiserConfig {
+    /// Features per frame (joints x representation size).
+    pub channels: usize,
+    /// Channels after the input convolution; doubled at each level.
+    pub width: usize,
+    /// Down-sampling levels along time (each halves the frames).
+    pub levels: usize,
+    /// Residual blocks at each level and in the bottleneck.
+    pub blocks: usize,
+    /// Kernel size of the convolutions (odd).
+    pub kernel: usize,
+    /// Frames per window (report: 16); a multiple of `2^levels`.
+    pub window: usize,
+}
+
+impl DenoiserConfig {
+    /// The small default: trains on a 2-core CPU in minutes.
+    pub fn small(channels: usize) -> DenoiserConfig {
+        DenoiserConfig {
+            channels,
+            width: 32,
+            levels: 2,
+            blocks: 1,
+            kernel: 3,
+            window: 16,
+        }
+    }
+
+    /// The report's large setting (deep residual encoder, for a GPU).
+    pub fn large(channels: usize) -> DenoiserConfig {
+        DenoiserConfig {
+            channels,
+            width: 128,
+            levels: 3,
+            blocks: 4,
+            kernel: 3,
+            window: 16,
+        }
+    }
+
+    /// Checks that the sizes fit together.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: &str| Err(CleanError::Invalid(format!("model configuration: {m}")));
+        if self.channels == 0 || self.width == 0 {
+            return bad("channels and width must be positive");
+        }
+        if self.kernel.is_multiple_of(2) {
+            return bad("the kernel size must be odd");
+        }
+        if self.levels > 6 || self.window == 0 || !self.window.is_multiple_of(1 << self.levels) {
+            return bad("the window must be a positive multiple of 2^levels (levels at most 6)");
+        }
+        Ok(())
+    }
+
+    fn width_at(&self, level: usize) -> usize {
+        self.width << level
+    }
+
+    /// Builds the network with fresh weights on `device`.
+    pub fn init(&self, device: &Device) -> Result<Denoiser> {
+        self.validate()?;
+        let conv = |cin: usize, cout: usize| {
+            Conv1dConfig::new(cin, cout, self.kernel)
+                .with_padding(PaddingConfig1d::Same)
+                .init(device)
+        };
+        let blocks = |w: usize| -> Vec<ResBlock> {
+            (0..self.blocks)
+                .map(|_| ResBlock {
+                    conv1: conv(w, w),
+                    conv2: conv(w, w),
+                })
+                .collect()
+        };
+        let mut encoder = Vec::new();
+        let mut decoder = Vec::new();
+        for level in 0..self.levels {
+            let (w, w2) = (self.width_at(level), self.width_at(level + 1));
+            encoder.push(EncoderLevel {
+                blocks: blocks(w),
+                down: Conv1dConfig::new(w, w2, 4)
+                    .with_stride(2)
+                    .with_padding(PaddingConfig1d::Explicit(1, 1))
+                    .init(device),
+            });
+            decoder.push(DecoderLevel {
+                up: ConvTranspose1dConfig::new([w2, w], 4)
+                    .with_stride(2)
+                    .with_padding(1)
+                    .init(device),
+                blocks: blocks(w),
+            });
+        }
+        Ok(Denoiser {
+            input: conv(self.channels, self.width),
+            encoder,
+            bottleneck: blocks(self.width_at(self.levels)),
+            decoder,
+            output: conv(self.width, self.channels),
+        })
+    }
+
+    /// Number of trainable numbers.
+    pub fn parameter_count(&self) -> usize {
+        let k = self.kernel;
+        let conv = |cin: usize, cout: usize, k: usize| cin * cout * k + cout;
+        let block = |w: usize| 2 * conv(w, w, k);
+        let mut n = conv(self.channels, self.width, k) + conv(self.width, self.channels, k);
+        for level in 0..self.levels {
+            let (w, w2) = (self.width_at(level), self.width_at(level + 1));
+            n += 2 * self.blocks * block(w) + conv(w, w2, 4) + (w2 * w * 4 + w);
+        }
+        n + self.blocks * block(self.width_at(self.levels))
+    }
+}
+
+/// `relu(x + conv2(relu(conv1(x))))`.
+#[derive(Module, Debug)]
+pub struct ResBlock {
+    conv1: Conv1d,
+    conv2: Conv1d,
+}
+
+impl ResBlock {
+    fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let y = self.conv2.forward(relu(self.conv1.forward(x.clone())));
+        relu(x + y)
+    }
+}
+
+#[derive(Module, Debug)]
+pub struct EncoderLevel {
+    blocks: Vec<ResBlock>,
+    down: Conv1d,
+}
+
+#[derive(Module, Debug)]
+pub struct DecoderLevel {
+    up: ConvTranspose1d,
+    blocks: Vec<ResBlock>,
+}
+
+/// The autoencoder (see the module docs).
+#[derive(Module, Debug)]
+pub struct Denoiser {
+    input: Conv1d,
+    encoder: Vec<EncoderLevel>,
+    bottleneck: Vec<ResBlock>,
+    decoder: Vec<DecoderLevel>,
+    output: Conv1d,
+}
+
+impl Denoiser {
+    /// Cleans a batch `[batch, channels, frames]`; `frames` must be a
+    /// multiple of `2^levels`.
+    pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let mut h = relu(self.input.forward(x.clone()));
+        let mut skips = Vec::with_capacity(self.encoder.len());
+        for level in &self.encoder {
+            for b in &level.blocks {
+                h = b.forward(h);
+            }
+            skips.push(h.clone());
+            h = relu(level.down.forward(h));
+        }
+        for b in &self.bottleneck {
+            h = b.forward(h);
+        }
+        for level in self.decoder.iter().rev() {
+            let skip = skips.pop().expect("one skip per level");
+            h = relu(level.up.forward(h)) + skip;
+            for b in &level.blocks {
+                h = b.forward(h);
+            }
+        }
+        x + self.output.forward(h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_has_the_input_shape() {
+        let device = Device::flex();
+        let config = DenoiserConfig::small(12);
+        let model = config.init(&device).unwrap();
+        let x = Tensor::<3>::zeros([2, 12, 16], &device);
+        assert_eq!(model.forward(x).dims(), [2, 12, 16]);
+        assert_eq!(model.num_params(), config.parameter_count());
+    }
+
+    #[test]
+    fn bad_sizes_are_errors() {
+        let mut c = DenoiserConfig::small(12);
+        c.window = 10;
+        assert!(c.validate().is_err());
+        c.window = 16;
+        c.kernel = 4;
+        assert!(c.validate().is_err());
+    }
+}

@@ -1,0 +1,406 @@
+//! Synthetic noise of markerless capture, added to clean motion to make
+//! training pairs and evaluation inputs.
+//!
+//! ## Random noise ([`RandomNoise`])
+//!
+//! Small per-frame errors of 2D pose estimation. Each joint gets its own
+//! random rotation error `d_j` (a rotation vector drawn from
+//! `N(0, sigma^2 / 3 I)`, so the RMS error angle is `sigma`); `sigma` is drawn
+//! per sample, uniformly in `[0, max_sigma]`.
+//!
+//! Applied naively to the local rotations (`q_j' = q_j d_j`), the error of a
+//! joint rotates every joint below it: the position error adds up from the
+//! root to the hands and feet. This is not what a keypoint detector does: it
+//! errs on each keypoint independently. So the default is
+//! *chain-corrected*: with global rotations `G` and positions `x`, in
+//! parent-before-child order,
+//!
+//! 1. the joint's global rotation is perturbed by its own error only,
+//!    `A_j = G_j d_j` (not by its ancestors');
+//! 2. `A_j` is then swung (shortest-arc rotation) so that its bone to its
+//!    main child `c` (the child with the longest offset) points from the
+//!    joint's *noisy* position `x_j'` to `x_c + e_c`, where
+//!    `e_c = (A_j - G_j) t_c` is the displacement that `d_j` alone gives the
+//!    child. The drift inherited from the ancestors is thereby cancelled;
+//! 3. local rotations are `q_j' = A_p'^-1 A_j'` (root: `A_root'`).
+//!
+//! The position error of every joint is therefore that of a single bone
+//! turned by about `sigma`, whatever its depth in the chain (measured in the
+//! tests: it grows with depth for the naive noise and stays flat here), and
+//! each bone's direction error stays about `sigma`.
+//!
+//! ## Spike noise ([`SpikeNoise`])
+//!
+//! A wrong association with another person: a random joint and every joint
+//! below it take the rotations of a different motion for a duration drawn
+//! from a half-normal distribution (`|N(0, duration_sigma^2)|` frames, at
+//! least one), with one to `max_spikes` simultaneous spikes.
+//!
+//! Root translation is never changed.
+
+use mocap_core::forward_kinematics;
+use mocap_core::rotation::{expmap_to_quat, Quat, Vec3};
+use mocap_core::Motion;
+use rand::{Rng, RngExt};
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+
+use crate::{CleanError, Result};
+
+/// Random per-frame noise (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RandomNoise {
+    /// Largest standard deviation of the per-joint error angle, in degrees
+    /// (report: 10). Each sample draws its own in `[0, max_sigma_deg]`.
+    pub max_sigma_deg: f32,
+    /// Correct the accumulation along the chain (default true).
+    pub chain_corrected: bool,
+}
+
+impl Default for RandomNoise {
+    fn default() -> Self {
+        RandomNoise {
+            max_sigma_deg: 10.0,
+            chain_corrected: true,
+        }
+    }
+}
+
+/// Spike noise: subtrees swapped with another motion (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SpikeNoise {
+    /// At most this many simultaneous spikes (report: 3).
+    pub max_spikes: usize,
+    /// Standard deviation of the spike duration in frames (report: 16).
+    pub duration_sigma_frames: f32,
+    /// Whether the root can be picked (then the whole pose is swapped).
+    pub include_root: bool,
+}
+
+impl Default for SpikeNoise {
+    fn default() -> Self {
+        SpikeNoise {
+            max_spikes: 3,
+            duration_sigma_frames: 16.0,
+            include_root: false,
+        }
+    }
+}
+
+/// One spike that was added: `joint` and its subtree, frames
+/// `start..start + frames`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Spike {
+    pub joint: usize,
+    pub start: usize,
+    pub frames: usize,
+}
+
+/// The noise of a training or evaluation sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NoiseConfig {
+    pub random: Option<RandomNoise>,
+    pub spikes: Option<SpikeNoise>,
+    /// Probability that a sample gets spikes (when `spikes` is set).
+    pub spike_probability: f32,
+}
+
+impl Default for NoiseConfig {
+    /// Both kinds: random noise on every sample, spikes on half of them.
+    fn default() -> Self {
+        NoiseConfig {
+            random: Some(RandomNoise::default()),
+            spikes: Some(SpikeNoise::default()),
+            spike_probability: 0.5,
+        }
+    }
+}
+
+/// A random rotation whose angle has RMS `sigma` radians.
+fn random_rotation<R: Rng + ?Sized>(rng: &mut R, sigma: f32) -> Quat {
+    if sigma <= 0.0 {
+        return Quat::IDENTITY;
+    }
+    let normal = Normal::new(0.0f32, sigma / 3f32.sqrt()).expect("finite sigma");
+    expmap_to_quat(Vec3::new(
+        normal.sample(rng),
+        normal.sample(rng),
+        normal.sample(rng),
+    ))
+}
+
+/// Adds random noise with a standard deviation drawn in
+/// `[0, max_sigma_deg]`; returns the noisy motion and the drawn sigma.
+pub fn add_random_noise<R: Rng + ?Sized>(
+    motion: &Motion,
+    params: &RandomNoise,
+    rng: &mut R,
+) -> (Motion, f32) {
+    let sigma_deg = rng.random::<f32>() * params.max_sigma_deg.max(0.0);
+    (
+        add_random_noise_sigma(motion, sigma_deg, params.chain_corrected, rng),
+        sigma_deg,
+    )
+}
+
+/// Adds random noise of standard deviation `sigma_deg` degrees.
+pub fn add_random_noise_sigma<R: Rng + ?Sized>(
+    motion: &Motion,
+    sigma_deg: f32,
+    chain_corrected: bool,
+    rng: &mut R,
+) -> Motion {
+    let sigma = sigma_deg.to_radians();
+    let skeleton = motion.skeleton();
+    let n = skeleton.joint_count();
+    let rotates: Vec<bool> = skeleton
+        .joints()
+        .iter()
+        .map(|j| j.channels.iter().any(|c| c.is_rotation()))
+        .collect();
+    let mut out = motion.clone();
+    if !chain_corrected {
+        for f in 0..motion.frame_count() {
+            for j in (0..n).filter(|&j| rotates[j]) {
+                let q = motion.local_rotation(f, j) * random_rotation(rng, sigma);
+                out.set_local_rotation(f, j, q);
+            }
+        }
+        return out;
+    }
+    // The main child of each joint: the child with the longest offset.
+    let main_child: Vec<Option<usize>> = (0..n)
+        .map(|j| {
+            skeleton
+                .children(j)
+                .max_by(|&a, &b| {
+                    skeleton
+                        .joint(a)
+                        .offset
+                        .length()
+                        .total_cmp(&skeleton.joint(b).offset.length())
+                })
+                .filter(|&c| skeleton.joint(c).offset.length() > 1e-6)
+        })
+        .collect();
+    let poses = forward_kinematics(motion);
+    let mut noisy_rot = vec![Quat::IDENTITY; n];
+    let mut noisy_pos = vec![Vec3::ZERO; n];
+    for f in 0..motion.frame_count() {
+        for j in 0..n {
+            let g = poses.rotation(f, j);
+            let x = poses.position(f, j);
+            let parent = skeleton.joint(j).parent;
+            let xj = match parent {
+                Some(p) => noisy_pos[p] + noisy_rot[p] * motion.local_translation(f, j),
+                None => x,
+            };
+            let mut a = if rotates[j] {
+                g * random_rotation(rng, sigma)
+            } else {
+                // A joint without rotation channels follows its parent.
+                match parent {
+                    Some(p) => noisy_rot[p] * motion.local_rotation(f, j),
+                    None => g,
+                }
+            };
+            if let (true, Some(c)) = (rotates[j], main_child[j]) {
+                let t = motion.local_translation(f, c);
+                let own_error = a * t - g * t;
+                let target = poses.position(f, c) + own_error - xj;
+                let current = a * t;
+                if target.length() > 1e-6 && current.length() > 1e-6 {
+                    a = Quat::from_rotation_arc(current.normalize(), target.normalize()) * a;
+                }
+            }
+            noisy_rot[j] = a.normalize();
+            noisy_pos[j] = xj;
+        }
+        for j in (0..n).filter(|&j| rotates[j]) {
+            let local = match skeleton.joint(j).parent {
+                Some(p) => noisy_rot[p].conjugate() * noisy_rot[j],
+                None => noisy_rot[j],
+            };
+            out.set_local_rotation(f, j, local.normalize());
+        }
+    }
+    out
+}
+
+/// Adds one to `max_spikes` spikes taken from `donors` (motions on the same
+/// skeleton, at least as long as `motion`; one is picked per spike).
+pub fn add_spike_noise<R: Rng + ?Sized>(
+    motion: &Motion,
+    donors: &[&Motion],
+    params: &SpikeNoise,
+    rng: &mut R,
+) -> Result<(Motion, Vec<Spike>)> {
+    let count = if params.max_spikes == 0 {
+        0
+    } else {
+        rng.random_range(1..=params.max_spikes)
+    };
+    let frames = motion.frame_count();
+    let mut spikes = Vec::with_capacity(count);
+    let duration = Normal::new(0.0f32, params.duration_sigma_frames.max(0.0))
+        .map_err(|e| CleanError::Invalid(format!("spike duration: {e}")))?;
+    for _ in 0..count {
+        let len = (duration.sample(rng).abs().ceil() as usize).max(1);
+        let start = rng.random_range(0..frames.max(1));
+        spikes.push(Spike {
+            joint: 0,
+            start,
+            frames: len.min(frames - start),
+        });
+    }
+    add_spikes(motion, donors, params, &mut spikes, rng)
+}
+
+/// Adds spikes of given starts and lengths (their joints are drawn); the
+/// evaluation uses it to place spikes of chosen lengths.
+pub fn add_spikes<R: Rng + ?Sized>(
+    motion: &Motion,
+    donors: &[&Motion],
+    params: &SpikeNoise,
+    spikes: &mut [Spike],
+    rng: &mut R,
+) -> Result<(Motion, Vec<Spike>)> {
+    let skeleton = motion.skeleton();
+    let frames = motion.frame_count();
+    for d in donors {
+        if d.skeleton().joint_count() != skeleton.joint_count() || d.frame_count() < frames {
+            return Err(CleanError::Invalid(format!(
+                "a spike donor must have the same skeleton ({} joints) and at least {frames} frames; got {} joints, {} frames",
+                skeleton.joint_count(),
+                d.skeleton().joint_count(),
+                d.frame_count()
+            )));
+        }
+    }
+    if donors.is_empty() {
+        return Err(CleanError::Invalid(
+            "spike noise needs at least one donor motion".into(),
+        ));
+    }
+    let candidates: Vec<usize> = (0..skeleton.joint_count())
+        .filter(|&j| params.include_root || skeleton.joint(j).parent.is_some())
+        .filter(|&j| skeleton.joint(j).channels.iter().any(|c| c.is_rotation()))
+        .collect();
+    if candidates.is_empty() {
+        return Err(CleanError::Invalid("no joint can take a spike".into()));
+    }
+    let mut out = motion.clone();
+    for spike in spikes.iter_mut() {
+        spike.joint = candidates[rng.random_range(0..candidates.len())];
+        let donor = donors[rng.random_range(0..donors.len())];
+        let subtree = skeleton.subtree(spike.joint);
+        let end = (spike.start + spike.frames).min(frames);
+        for f in spike.start..end {
+            for &j in &subtree {
+                out.set_local_rotation(f, j, donor.local_rotation(f, j));
+            }
+        }
+        // Frames after the spike keep continuous Euler tracks: rewrite the
+        // next frame's rotations through set_local_rotation as well.
+        if end < frames {
+            for &j in &subtree {
+                out.set_local_rotation(end, j, motion.local_rotation(end, j));
+            }
+        }
+    }
+    Ok((out, spikes.to_vec()))
+}
+
+/// Applies `config` to `motion`: random noise, then (with the configured
+/// probability) spikes from `donors`.
+pub fn add_noise<R: Rng + ?Sized>(
+    motion: &Motion,
+    donors: &[&Motion],
+    config: &NoiseConfig,
+    rng: &mut R,
+) -> Result<Motion> {
+    let mut noisy = match &config.random {
+        Some(r) => add_random_noise(motion, r, rng).0,
+        None => motion.clone(),
+    };
+    if let Some(s) = &config.spikes {
+        if rng.random::<f32>() < config.spike_probability {
+            noisy = add_spike_noise(&noisy, donors, s, rng)?.0;
+        }
+    }
+    Ok(noisy)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::synthetic_motion;
+    use rand::rngs::ChaCha8Rng;
+    use rand::SeedableRng;
+
+    /// Mean position error of each joint, over frames.
+    fn position_errors(a: &Motion, b: &Motion) -> Vec<f32> {
+        let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
+        let n = a.skeleton().joint_count();
+        (0..n)
+            .map(|j| {
+                (0..a.frame_count())
+                    .map(|f| (pa.position(f, j) - pb.position(f, j)).length())
+                    .sum::<f32>()
+                    / a.frame_count() as f32
+            })
+            .collect()
+    }
+
+    #[test]
+    fn chain_correction_keeps_the_error_flat_along_the_chain() {
+        // A straight chain of equal bones: naive noise grows with depth.
+        let motion = synthetic_motion(400, 11);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let naive = add_random_noise_sigma(&motion, 5.0, false, &mut rng);
+        let corrected = add_random_noise_sigma(&motion, 5.0, true, &mut rng);
+        let en = position_errors(&motion, &naive);
+        let ec = position_errors(&motion, &corrected);
+        let last = en.len() - 1;
+        // Naive: the chain end errs far more than the first bone.
+        assert!(en[last] > 3.0 * en[1], "naive {en:?}");
+        // Corrected: about the same error at every depth.
+        assert!(ec[last] < 1.6 * ec[1], "corrected {ec:?}");
+        assert!(ec[last] < 0.5 * en[last]);
+        // The per-bone error is about sigma * bone length (10 units, 5 deg).
+        let expected = 10.0 * 5f32.to_radians();
+        assert!(ec[1] > 0.4 * expected && ec[1] < 2.0 * expected, "{ec:?}");
+        // Root translation untouched.
+        for f in 0..motion.frame_count() {
+            assert_eq!(motion.root_translation(f), corrected.root_translation(f));
+        }
+    }
+
+    #[test]
+    fn spikes_swap_a_subtree_for_a_while() {
+        let motion = synthetic_motion(60, 6);
+        let donor = crate::test_support::synthetic_motion_phase(60, 6, 2.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let params = SpikeNoise {
+            max_spikes: 1,
+            duration_sigma_frames: 10.0,
+            include_root: false,
+        };
+        let (noisy, spikes) = add_spike_noise(&motion, &[&donor], &params, &mut rng).unwrap();
+        assert_eq!(spikes.len(), 1);
+        let s = spikes[0];
+        let subtree = motion.skeleton().subtree(s.joint);
+        for f in 0..motion.frame_count() {
+            for j in 0..motion.skeleton().joint_count() {
+                let inside = f >= s.start && f < s.start + s.frames && subtree.contains(&j);
+                let want = if inside {
+                    donor.local_rotation(f, j)
+                } else {
+                    motion.local_rotation(f, j)
+                };
+                let angle = mocap_core::rotation::angle_between(noisy.local_rotation(f, j), want);
+                assert!(angle < 1e-3, "frame {f} joint {j} inside {inside}");
+            }
+        }
+    }
+}

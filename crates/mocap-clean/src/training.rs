@@ -1,0 +1,500 @@
+//! Training the denoiser: windows of clean takes with noise generated on the
+//! fly, Adam, validation after every epoch, checkpoints, resume, and a PNG
+//! of the loss curves.
+//!
+//! Reproducibility: the network is initialised from `seed`, and the samples
+//! of epoch `e` come from a generator seeded with `(seed, e)`, so a resumed
+//! run draws exactly the samples an uninterrupted one would. The validation
+//! windows are drawn once from a fixed seed that does not depend on `seed`,
+//! so runs with different seeds and losses are validated on the same data.
+//! The validation loss is the plain mean squared error of the features, for
+//! every training loss, so that curves of different losses compare.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use burn::module::Module;
+use burn::optim::AdamConfig;
+use burn::tensor::{Device, Tensor, TensorData};
+use mocap_core::Motion;
+use mocap_nn::checkpoint::{save_weights, CheckpointHeader, TrainingState};
+use mocap_nn::device::{seed_device, DeviceChoice};
+use mocap_nn::plot::{history_series, plot_lines, PlotOptions};
+use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
+use rand::rngs::ChaCha8Rng;
+use rand::{Rng, RngExt, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::{
+    list_bvh, load_takes, paths_in_split, split_of, take_name, window, DataDescription, Split,
+    SplitFractions, Take,
+};
+use crate::features::{FeatureLayout, Representation};
+use crate::loss::{derivative_loss, LossWeights};
+use crate::model::{Denoiser, DenoiserConfig};
+use crate::noise::{add_noise, NoiseConfig};
+use crate::{CleanError, Result};
+
+/// The kind written in checkpoint headers.
+pub const CHECKPOINT_KIND: &str = "mocap-clean/denoiser";
+/// Version of [`ModelDescription`]'s layout.
+pub const CHECKPOINT_KIND_VERSION: u32 = 1;
+
+/// The seed of the validation windows (fixed across runs).
+const VALIDATION_SEED: u64 = 0x0005_eed0_fba1;
+
+/// Everything needed to rebuild a trained denoiser, stored in its checkpoint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelDescription {
+    pub network: DenoiserConfig,
+    pub representation: Representation,
+    /// Names of the joints whose rotations are features, in order.
+    pub joints: Vec<String>,
+    /// Frame rate of the training data (the loss differences use it).
+    pub fps: f32,
+}
+
+/// Options of `mocap clean train`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TrainOptions {
+    /// Folders or files of clean BVH takes (split by take).
+    pub inputs: Vec<PathBuf>,
+    /// The model file to write (safetensors).
+    pub out: PathBuf,
+    /// Folder of the resumable training state; default `<out>.state`.
+    pub state_dir: Option<PathBuf>,
+    /// Continue from the state folder when it holds a state.
+    pub resume: bool,
+    pub representation: Representation,
+    /// Network sizes; `channels` is set from the data.
+    pub network: DenoiserConfig,
+    pub epochs: usize,
+    pub steps_per_epoch: usize,
+    pub batch_size: usize,
+    pub learning_rate: f64,
+    /// Loss weights; `fps` is replaced by the data's frame rate when
+    /// `derivative_loss` is set.
+    pub alpha: f32,
+    pub beta: f32,
+    /// Use the report's `alpha = dt^2`, `beta = dt^4` (overrides alpha, beta).
+    pub derivative_loss: bool,
+    pub noise: NoiseConfig,
+    pub split: SplitFractions,
+    pub validation_windows: usize,
+    pub seed: u64,
+    pub device: DeviceChoice,
+    /// Loss-curve PNG; default `<out>` with extension `png`.
+    pub plot: Option<PathBuf>,
+    /// Use at most this many training takes (quick runs and tests).
+    pub max_train_takes: Option<usize>,
+}
+
+impl Default for TrainOptions {
+    /// The shipped default: small network, 6D rotations, derivative loss,
+    /// both noise kinds, Adam with lr 1e-3 and batch 512.
+    fn default() -> Self {
+        TrainOptions {
+            inputs: Vec::new(),
+            out: PathBuf::from("clean.safetensors"),
+            state_dir: None,
+            resume: false,
+            representation: Representation::Rot6d,
+            network: DenoiserConfig::small(0),
+            epochs: 20,
+            steps_per_epoch: 40,
+            batch_size: 512,
+            learning_rate: 1e-3,
+            alpha: 0.0,
+            beta: 0.0,
+            derivative_loss: true,
+            noise: NoiseConfig::default(),
+            split: SplitFractions::default(),
+            validation_windows: 1024,
+            seed: 1,
+            device: DeviceChoice::Cpu,
+            plot: None,
+            max_train_takes: None,
+        }
+    }
+}
+
+/// What `mocap clean train` reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TrainReport {
+    pub model: PathBuf,
+    pub plot: PathBuf,
+    pub description: ModelDescription,
+    pub parameters: usize,
+    pub loss: LossWeights,
+    pub data: DataDescription,
+    pub history: History,
+    /// Training samples per second (training steps only).
+    pub samples_per_second: f64,
+    /// Wall-clock seconds of this call (loading data included).
+    pub seconds: f64,
+    pub resumed_from_epoch: usize,
+    /// Seconds per step spent drawing windows and making noise (part of
+    /// the training time above).
+    pub data_seconds_per_step: f64,
+    /// Validation MSE of the noisy input itself (what the curves start from).
+    pub validation_input_mse: f64,
+}
+
+/// Draws training pairs (noisy, clean) of features from takes.
+pub struct WindowSampler<'a> {
+    takes: Vec<&'a Take>,
+    /// Cumulative count of window starts, to pick a window uniformly.
+    cumulative: Vec<usize>,
+    layout: &'a FeatureLayout,
+    frames: usize,
+    noise: NoiseConfig,
+}
+
+impl<'a> WindowSampler<'a> {
+    /// A sampler of windows of `frames` frames; takes shorter than that are
+    /// skipped.
+    pub fn new(
+        takes: &'a [Take],
+        layout: &'a FeatureLayout,
+        frames: usize,
+        noise: NoiseConfig,
+    ) -> Result<Self> {
+        let takes: Vec<&Take> = takes
+            .iter()
+            .filter(|t| t.motion.frame_count() >= frames)
+            .collect();
+        let mut cumulative = Vec::with_capacity(takes.len());
+        let mut total = 0;
+        for t in &takes {
+            total += t.motion.frame_count() - frames + 1;
+            cumulative.push(total);
+        }
+        if takes.len() < 2 {
+            return Err(CleanError::Invalid(format!(
+                "need at least two takes of {frames} frames or more (spikes are taken from another take)"
+            )));
+        }
+        Ok(WindowSampler {
+            takes,
+            cumulative,
+            layout,
+            frames,
+            noise,
+        })
+    }
+
+    fn pick<R: Rng + ?Sized>(&self, rng: &mut R) -> (usize, usize) {
+        let total = *self.cumulative.last().expect("at least two takes");
+        let u = rng.random_range(0..total);
+        let t = self.cumulative.partition_point(|&c| c <= u);
+        let before = if t == 0 { 0 } else { self.cumulative[t - 1] };
+        (t, u - before)
+    }
+
+    /// One clean window and its noisy copy.
+    pub fn sample_motion<R: Rng + ?Sized>(&self, rng: &mut R) -> Result<(Motion, Motion)> {
+        let (t, start) = self.pick(rng);
+        let clean = window(&self.takes[t].motion, start, self.frames);
+        // Spike donors: windows of other takes.
+        let mut donors = Vec::new();
+        for _ in 0..self.noise.spikes.map_or(0, |s| s.max_spikes.max(1)) {
+            let (mut d, mut s) = self.pick(rng);
+            while d == t {
+                (d, s) = self.pick(rng);
+            }
+            donors.push(window(&self.takes[d].motion, s, self.frames));
+        }
+        let donor_refs: Vec<&Motion> = donors.iter().collect();
+        let noisy = add_noise(&clean, &donor_refs, &self.noise, rng)?;
+        Ok((noisy, clean))
+    }
+
+    /// A batch as `[batch, channels, frames]` tensors data (noisy, clean).
+    pub fn batch<R: Rng + ?Sized>(&self, rng: &mut R, size: usize) -> Result<(Vec<f32>, Vec<f32>)> {
+        let c = self.layout.channels();
+        let t = self.frames;
+        let mut x = vec![0.0; size * c * t];
+        let mut y = vec![0.0; size * c * t];
+        for b in 0..size {
+            let (noisy, clean) = self.sample_motion(rng)?;
+            let mut xf = self.layout.encode(&noisy);
+            let mut yf = self.layout.encode(&clean);
+            // Euler windows: the same whole turns off input and target.
+            let offsets = self.layout.recenter(&mut xf);
+            for frame in yf.chunks_mut(c) {
+                for (v, o) in frame.iter_mut().zip(&offsets) {
+                    *v -= o;
+                }
+            }
+            for f in 0..t {
+                for ch in 0..c {
+                    x[(b * c + ch) * t + f] = xf[f * c + ch];
+                    y[(b * c + ch) * t + f] = yf[f * c + ch];
+                }
+            }
+        }
+        Ok((x, y))
+    }
+}
+
+fn tensor(data: Vec<f32>, shape: [usize; 3], device: &Device) -> Tensor<3> {
+    Tensor::from_data(TensorData::new(data, shape), device)
+}
+
+/// The mean squared error of `model` on fixed validation batches.
+fn validation_mse(
+    model: &Denoiser,
+    batches: &[(Vec<f32>, Vec<f32>)],
+    shape: [usize; 3],
+    device: &Device,
+) -> f64 {
+    let model = model.valid();
+    let mut sum = 0.0;
+    for (x, y) in batches {
+        let pred = model.forward(tensor(x.clone(), shape, device));
+        let mse: f32 = (pred - tensor(y.clone(), shape, device))
+            .powi_scalar(2)
+            .mean()
+            .into_scalar();
+        sum += mse as f64;
+    }
+    sum / batches.len().max(1) as f64
+}
+
+#[derive(Serialize, Deserialize)]
+struct Progress {
+    history: History,
+}
+
+fn with_extension(path: &Path, extension: &str) -> PathBuf {
+    path.with_extension(extension)
+}
+
+/// Trains a denoiser (see the module docs).
+pub fn train(options: &TrainOptions) -> Result<TrainReport> {
+    let started = Instant::now();
+    let paths = list_bvh(&options.inputs)?;
+    let mut train_paths = paths_in_split(&paths, Split::Train, &options.split);
+    if let Some(max) = options.max_train_takes {
+        train_paths.truncate(max);
+    }
+    let valid_paths = paths_in_split(&paths, Split::Validation, &options.split);
+    let train_takes = load_takes(&train_paths)?;
+    let valid_takes = load_takes(&valid_paths)?;
+    let first = train_takes
+        .first()
+        .ok_or_else(|| CleanError::Invalid("no training takes".into()))?;
+    let fps = first.motion.fps() as f32;
+    let layout = FeatureLayout::new(first.motion.skeleton(), options.representation)?;
+    let joints: Vec<String> = layout
+        .joints
+        .iter()
+        .map(|&j| first.motion.skeleton().joint(j).name.clone())
+        .collect();
+    let mut network = options.network;
+    network.channels = layout.channels();
+    network.validate()?;
+    let description = ModelDescription {
+        network,
+        representation: options.representation,
+        joints,
+        fps,
+    };
+    let loss = if options.derivative_loss {
+        LossWeights::derivative(fps)
+    } else {
+        LossWeights {
+            alpha: options.alpha,
+            beta: options.beta,
+            fps,
+        }
+    };
+    let held_out = paths
+        .iter()
+        .map(|p| take_name(p))
+        .filter(|n| split_of(n, &options.split) != Split::Train)
+        .collect();
+    let data = DataDescription {
+        inputs: options
+            .inputs
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
+        split: options.split,
+        train_takes: train_takes.len(),
+        train_frames: train_takes.iter().map(|t| t.motion.frame_count()).sum(),
+        validation_takes: valid_takes.len(),
+        validation_frames: valid_takes.iter().map(|t| t.motion.frame_count()).sum(),
+        test_takes: paths_in_split(&paths, Split::Test, &options.split).len(),
+        fps: fps as f64,
+        held_out,
+    };
+
+    let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?;
+    let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?;
+    let shape = [options.batch_size, network.channels, network.window];
+    let mut valid_rng = ChaCha8Rng::seed_from_u64(VALIDATION_SEED);
+    let valid_batches = (0..options
+        .validation_windows
+        .div_ceil(options.batch_size)
+        .max(1))
+        .map(|_| valid_sampler.batch(&mut valid_rng, options.batch_size))
+        .collect::<Result<Vec<_>>>()?;
+
+    // The validation MSE of doing nothing (the noisy input itself), for scale.
+    let validation_input_mse = valid_batches
+        .iter()
+        .map(|(x, y)| {
+            x.iter()
+                .zip(y)
+                .map(|(a, b)| ((a - b) * (a - b)) as f64)
+                .sum::<f64>()
+                / x.len() as f64
+        })
+        .sum::<f64>()
+        / valid_batches.len() as f64;
+    let device = options.device.training_device()?;
+    let plain_device = options.device.device()?;
+    seed_device(&device, options.seed);
+    let mut model = network.init(&device)?;
+    let mut optimizer = AdamConfig::new().init();
+    let mut history = History::default();
+    let state_dir = options
+        .state_dir
+        .clone()
+        .unwrap_or_else(|| with_extension(&options.out, "state"));
+    let state = TrainingState::new(&state_dir);
+    if options.resume && state.exists() {
+        let (m, o, progress): (Denoiser, _, Progress) = state.load(model, optimizer)?;
+        model = m;
+        optimizer = o;
+        history = progress.history;
+    }
+    let resumed_from_epoch = history.epochs.len();
+    let plot = options
+        .plot
+        .clone()
+        .unwrap_or_else(|| with_extension(&options.out, "png"));
+    let header = |history: &History| CheckpointHeader {
+        kind: CHECKPOINT_KIND.into(),
+        kind_version: CHECKPOINT_KIND_VERSION,
+        config: serde_json::to_value(&description).expect("serialisable"),
+        data: serde_json::json!({ "data": data, "noise": options.noise }),
+        training: serde_json::json!({
+            "loss": loss,
+            "epochs": history.epochs.len(),
+            "steps_per_epoch": options.steps_per_epoch,
+            "batch_size": options.batch_size,
+            "learning_rate": options.learning_rate,
+            "seed": options.seed,
+            "history": history,
+        }),
+    };
+
+    let plan = EpochPlan {
+        epochs: options.epochs,
+        steps_per_epoch: options.steps_per_epoch,
+        batch_size: options.batch_size,
+    };
+    struct Run {
+        model: Option<Denoiser>,
+        optimizer: burn::optim::ModuleOptimizer,
+        rng: ChaCha8Rng,
+        rng_epoch: usize,
+        data_seconds: f64,
+    }
+    let mut run = Run {
+        model: Some(model),
+        optimizer,
+        rng: ChaCha8Rng::seed_from_u64(0),
+        rng_epoch: usize::MAX,
+        data_seconds: 0.0,
+    };
+    run_epochs(
+        &mut run,
+        &mut history,
+        plan,
+        |run, epoch, _step| -> Result<f64> {
+            if run.rng_epoch != epoch {
+                run.rng = ChaCha8Rng::seed_from_u64(
+                    options.seed ^ (epoch as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15),
+                );
+                run.rng_epoch = epoch;
+            }
+            let data_start = Instant::now();
+            let (x, y) = train_sampler.batch(&mut run.rng, options.batch_size)?;
+            run.data_seconds += data_start.elapsed().as_secs_f64();
+            let model = run.model.take().expect("model present");
+            let pred = model.forward(tensor(x, shape, &device));
+            let l = derivative_loss(pred, tensor(y, shape, &device), &loss);
+            let value: f32 = l.clone().into_scalar();
+            if !value.is_finite() {
+                return Err(CleanError::Invalid(format!(
+                    "the training loss became {value} at epoch {}: lower the learning rate",
+                    epoch + 1
+                )));
+            }
+            run.model = Some(optimizer_step(
+                model,
+                &mut run.optimizer,
+                l,
+                options.learning_rate,
+            ));
+            Ok(value as f64)
+        },
+        |run, _epoch| {
+            Ok(validation_mse(
+                run.model.as_ref().expect("model"),
+                &valid_batches,
+                shape,
+                &plain_device,
+            ))
+        },
+        |run, history| {
+            let model = run.model.as_ref().expect("model");
+            state.save(
+                model,
+                &run.optimizer,
+                &Progress {
+                    history: history.clone(),
+                },
+            )?;
+            save_weights(&options.out, &model.valid(), &header(history))?;
+            plot_lines(
+                &plot,
+                &history_series(history, ""),
+                &PlotOptions {
+                    y_label: "loss (training: chosen loss; validation: MSE)".into(),
+                    ..PlotOptions::new(format!(
+                        "mocap-clean training ({})",
+                        if loss.is_mse() {
+                            "MSE"
+                        } else {
+                            "derivative loss"
+                        }
+                    ))
+                },
+            )?;
+            Ok(())
+        },
+    )?;
+    if history.epochs.is_empty() {
+        return Err(CleanError::Invalid("no epoch was run (epochs = 0)".into()));
+    }
+    let samples_per_second = history.samples_per_second();
+    let steps_run = (history.epochs.len() - resumed_from_epoch) * options.steps_per_epoch;
+    Ok(TrainReport {
+        model: options.out.clone(),
+        plot,
+        parameters: network.parameter_count(),
+        description,
+        loss,
+        data,
+        samples_per_second,
+        seconds: started.elapsed().as_secs_f64(),
+        resumed_from_epoch,
+        history,
+        data_seconds_per_step: run.data_seconds / steps_run.max(1) as f64,
+        validation_input_mse,
+    })
+}

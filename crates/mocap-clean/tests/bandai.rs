@@ -1,0 +1,147 @@
+//! Tests on real takes of the Bandai Namco data set (skipped with a note
+//! when the shared data is absent).
+
+use std::path::PathBuf;
+
+use mocap_clean::eval::{position_errors, rotation_error_deg};
+use mocap_clean::filters::{filter_motion, Filter};
+use mocap_clean::infer::{CleanModel, DEFAULT_MODEL_PATH};
+use mocap_clean::noise::{add_random_noise_sigma, add_spike_noise, SpikeNoise};
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::{forward_kinematics, Motion};
+use rand::rngs::ChaCha8Rng;
+use rand::SeedableRng;
+
+fn shared_data() -> Option<PathBuf> {
+    let dir = std::env::var_os("MOCAP_SHARED_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    if dir.join("bandai").is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "note: {} not found, skipping the Bandai tests",
+            dir.display()
+        );
+        None
+    }
+}
+
+fn take(name: &str) -> Option<Motion> {
+    let dir = shared_data()?;
+    Some(read_bvh(&dir.join("bandai/dataset-1").join(name)).expect("readable take"))
+}
+
+/// Mean position error of one joint.
+fn joint_error(a: &Motion, b: &Motion, joint: usize) -> f32 {
+    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
+    (0..a.frame_count())
+        .map(|f| (pa.position(f, joint) - pb.position(f, joint)).length())
+        .sum::<f32>()
+        / a.frame_count() as f32
+}
+
+#[test]
+fn chain_corrected_noise_does_not_grow_towards_the_hands() {
+    let Some(motion) = take("dataset-1_walk_normal_001.bvh") else {
+        return;
+    };
+    let s = motion.skeleton();
+    let hand = s.find("Hand_L").expect("the Bandai rig has Hand_L");
+    // The joint two levels above the hand (the upper arm).
+    let elbow = s.joint(hand).parent.unwrap();
+    let shoulder = s.joint(elbow).parent.unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let naive = add_random_noise_sigma(&motion, 5.0, false, &mut rng);
+    let corrected = add_random_noise_sigma(&motion, 5.0, true, &mut rng);
+    let (nh, ns) = (
+        joint_error(&motion, &naive, hand),
+        joint_error(&motion, &naive, shoulder),
+    );
+    let (ch, cs) = (
+        joint_error(&motion, &corrected, hand),
+        joint_error(&motion, &corrected, shoulder),
+    );
+    eprintln!("naive: shoulder {ns:.2} hand {nh:.2}; corrected: shoulder {cs:.2} hand {ch:.2}");
+    assert!(ch < 0.6 * nh, "corrected hand error {ch} vs naive {nh}");
+    assert!(
+        ch < 2.0 * cs.max(0.5),
+        "corrected error grows along the arm: {cs} -> {ch}"
+    );
+}
+
+#[test]
+fn filters_reduce_random_noise_on_a_real_take() {
+    let Some(motion) = take("dataset-1_walk_normal_001.bvh") else {
+        return;
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    let noisy = add_random_noise_sigma(&motion, 8.0, true, &mut rng);
+    let before = rotation_error_deg(&motion, &noisy);
+    let out = filter_motion(
+        &noisy,
+        &Filter::Butterworth {
+            order: 2,
+            cutoff_hz: 4.0,
+        },
+    )
+    .unwrap();
+    let after = rotation_error_deg(&motion, &out);
+    assert!(after < 0.7 * before, "{before} -> {after}");
+    let (p, _) = position_errors(&motion, &out);
+    assert!(p.is_finite());
+}
+
+#[test]
+fn the_shipped_model_cleans_a_held_out_take() {
+    let Some(dir) = shared_data() else { return };
+    if !PathBuf::from(DEFAULT_MODEL_PATH).is_file() {
+        eprintln!("note: no shipped model at {DEFAULT_MODEL_PATH}");
+        return;
+    }
+    let model = CleanModel::load_default(Default::default()).unwrap();
+    // A take of the test split (never seen in training).
+    let paths = mocap_clean::dataset::list_bvh(&[dir.join("bandai/dataset-1")]).unwrap();
+    let test = mocap_clean::dataset::paths_in_split(
+        &paths,
+        mocap_clean::dataset::Split::Test,
+        &Default::default(),
+    );
+    let motion = read_bvh(&test[0]).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let noisy = add_random_noise_sigma(&motion, 8.0, true, &mut rng);
+    let donor = read_bvh(&test[1]).unwrap();
+    let long_enough: Vec<f32> = (0..motion.frame_count())
+        .flat_map(|f| donor.frame(f % donor.frame_count()).to_vec())
+        .collect();
+    let donor = Motion::new(
+        donor.skeleton().clone(),
+        donor.frame_time(),
+        motion.frame_count(),
+        long_enough,
+    )
+    .unwrap();
+    let (noisy, _) = add_spike_noise(
+        &noisy,
+        &[&donor],
+        &SpikeNoise {
+            max_spikes: 1,
+            ..Default::default()
+        },
+        &mut rng,
+    )
+    .unwrap();
+    let cleaned = model.clean(&noisy, None).unwrap();
+    assert_eq!(cleaned.skeleton(), motion.skeleton());
+    assert_eq!(cleaned.frame_count(), motion.frame_count());
+    for f in 0..motion.frame_count() {
+        assert_eq!(cleaned.root_translation(f), noisy.root_translation(f));
+    }
+    let before = rotation_error_deg(&motion, &noisy);
+    let after = rotation_error_deg(&motion, &cleaned);
+    eprintln!(
+        "{}: rotation error {before:.2} -> {after:.2} degrees",
+        test[0].display()
+    );
+    assert!(after < 0.6 * before, "{before} -> {after}");
+}

@@ -1,0 +1,258 @@
+//! Checkpoints: network weights in a safetensors file whose header says what
+//! the weights are.
+//!
+//! A safetensors file starts with a JSON header that may hold a string map
+//! `__metadata__`. We store there, next to burn's own keys:
+//!
+//! - `mocap.format` = [`FORMAT`] and `mocap.format_version` = [`FORMAT_VERSION`]:
+//!   the layout of this header, bumped when it changes incompatibly;
+//! - `mocap.header`: a JSON [`CheckpointHeader`] with the kind of model (for
+//!   example `mocap-clean/denoiser`) and its own version, the model
+//!   configuration, and a description of the training data and run.
+//!
+//! The header is read first, the model built from its configuration, then the
+//! tensors are loaded into it; a tensor that is missing or of the wrong shape
+//! is an error naming the file.
+//!
+//! Training state for resuming ([`TrainingState`]) is kept apart: burn's own
+//! burnpack format for the weights (it keeps the parameter ids the optimizer
+//! state is keyed by), the optimizer state, and a JSON file of progress.
+
+use std::path::{Path, PathBuf};
+
+use burn::module::Module;
+use burn::optim::ModuleOptimizer;
+use burn::store::{BurnpackStore, ModuleSnapshot, SafetensorsStore};
+use burn::tensor::Bytes;
+use mocap_core::io::atomic::write_bytes_atomically;
+use serde::{Deserialize, Serialize};
+
+use crate::{NnError, Result};
+
+/// Value of the `mocap.format` metadata key.
+pub const FORMAT: &str = "mocap-nn checkpoint";
+/// Version of the header layout.
+pub const FORMAT_VERSION: u32 = 1;
+
+const KEY_FORMAT: &str = "mocap.format";
+const KEY_VERSION: &str = "mocap.format_version";
+const KEY_HEADER: &str = "mocap.header";
+
+/// What a checkpoint holds, stored in its safetensors header.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointHeader {
+    /// The kind of model, e.g. `mocap-clean/denoiser`.
+    pub kind: String,
+    /// Version of that model's configuration layout.
+    pub kind_version: u32,
+    /// The model configuration (enough to rebuild the network).
+    pub config: serde_json::Value,
+    /// The training data: files, splits, noise, representation...
+    pub data: serde_json::Value,
+    /// The training run: epochs, losses, seed, timings...
+    pub training: serde_json::Value,
+}
+
+fn checkpoint_error(path: &Path, message: impl Into<String>) -> NnError {
+    NnError::Checkpoint {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+/// Writes `module`'s weights and `header` to `path` (atomically).
+pub fn save_weights<M: Module>(path: &Path, module: &M, header: &CheckpointHeader) -> Result<()> {
+    let bytes = weights_to_bytes(module, header).map_err(|m| checkpoint_error(path, m))?;
+    write_bytes_atomically(path, &bytes)?;
+    Ok(())
+}
+
+/// The safetensors bytes of `module`'s weights with `header`.
+pub fn weights_to_bytes<M: Module>(
+    module: &M,
+    header: &CheckpointHeader,
+) -> std::result::Result<Vec<u8>, String> {
+    let header_json = serde_json::to_string(header).map_err(|e| e.to_string())?;
+    let mut store = SafetensorsStore::from_bytes(None)
+        .metadata(KEY_FORMAT, FORMAT)
+        .metadata(KEY_VERSION, FORMAT_VERSION.to_string())
+        .metadata(KEY_HEADER, header_json);
+    module
+        .save_into(&mut store)
+        .map_err(|e| format!("cannot serialise the weights: {e}"))?;
+    store
+        .get_bytes()
+        .map_err(|e| format!("cannot serialise the weights: {e}"))
+}
+
+/// Reads the header of the checkpoint at `path`.
+pub fn read_header(path: &Path) -> Result<CheckpointHeader> {
+    let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+    header_from_bytes(&bytes, path)
+}
+
+/// Reads the header of checkpoint bytes; `origin` names them in errors.
+pub fn header_from_bytes(bytes: &[u8], origin: &Path) -> Result<CheckpointHeader> {
+    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+        .map_err(|e| checkpoint_error(origin, format!("not a safetensors file ({e})")))?;
+    let map = metadata.metadata().clone().unwrap_or_default();
+    match map.get(KEY_FORMAT) {
+        Some(f) if f == FORMAT => {}
+        Some(f) => {
+            return Err(checkpoint_error(
+                origin,
+                format!("expected a `{FORMAT}` file, found `{f}`"),
+            ))
+        }
+        None => {
+            return Err(checkpoint_error(
+                origin,
+                format!(
+                    "a safetensors file without the `{KEY_FORMAT}` header: not written by mocap"
+                ),
+            ))
+        }
+    }
+    let version: u32 = map
+        .get(KEY_VERSION)
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| checkpoint_error(origin, format!("missing or bad `{KEY_VERSION}`")))?;
+    if version != FORMAT_VERSION {
+        return Err(checkpoint_error(
+            origin,
+            format!(
+                "checkpoint format version {version}, this build reads version {FORMAT_VERSION}"
+            ),
+        ));
+    }
+    let header = map
+        .get(KEY_HEADER)
+        .ok_or_else(|| checkpoint_error(origin, format!("missing `{KEY_HEADER}`")))?;
+    serde_json::from_str(header)
+        .map_err(|e| checkpoint_error(origin, format!("bad `{KEY_HEADER}` JSON: {e}")))
+}
+
+/// Loads the weights in `bytes` into `module` (built from the header's
+/// configuration). Every tensor of the module must be present with its shape.
+pub fn load_weights_from_bytes<M: Module>(
+    bytes: Vec<u8>,
+    origin: &Path,
+    mut module: M,
+) -> Result<M> {
+    let mut store = SafetensorsStore::from_bytes(Some(bytes));
+    let result = module
+        .load_from(&mut store)
+        .map_err(|e| checkpoint_error(origin, format!("cannot read the weights: {e}")))?;
+    if !result.is_success() || !result.missing.is_empty() {
+        return Err(checkpoint_error(
+            origin,
+            format!(
+                "the weights do not fit the model: {} missing, {} errors ({})",
+                result.missing.len(),
+                result.errors.len(),
+                result
+                    .errors
+                    .iter()
+                    .map(|e| e.to_string())
+                    .chain(result.missing.iter().map(|(p, _)| format!("missing {p}")))
+                    .take(3)
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        ));
+    }
+    Ok(module)
+}
+
+/// Loads the weights at `path` into `module`.
+pub fn load_weights<M: Module>(path: &Path, module: M) -> Result<M> {
+    let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+    load_weights_from_bytes(bytes, path, module)
+}
+
+/// The files of a resumable training state in a folder: `model.bpk`,
+/// `optimizer.bpk` and `progress.json`.
+#[derive(Debug, Clone)]
+pub struct TrainingState {
+    pub dir: PathBuf,
+}
+
+impl TrainingState {
+    pub fn new(dir: impl Into<PathBuf>) -> TrainingState {
+        TrainingState { dir: dir.into() }
+    }
+
+    fn model_path(&self) -> PathBuf {
+        self.dir.join("model.bpk")
+    }
+
+    fn optimizer_path(&self) -> PathBuf {
+        self.dir.join("optimizer.bpk")
+    }
+
+    fn progress_path(&self) -> PathBuf {
+        self.dir.join("progress.json")
+    }
+
+    /// Whether a complete state is there to resume from.
+    pub fn exists(&self) -> bool {
+        self.model_path().is_file()
+            && self.optimizer_path().is_file()
+            && self.progress_path().is_file()
+    }
+
+    /// Saves the model, the optimizer and `progress` (each file atomically;
+    /// the progress file last, so a state is only complete once it is written).
+    pub fn save<M: Module, P: Serialize>(
+        &self,
+        module: &M,
+        optimizer: &ModuleOptimizer,
+        progress: &P,
+    ) -> Result<()> {
+        std::fs::create_dir_all(&self.dir).map_err(|e| mocap_core::Error::io(&self.dir, e))?;
+        let mut store = BurnpackStore::from_bytes(None);
+        module
+            .save_into(&mut store)
+            .map_err(|e| checkpoint_error(&self.model_path(), e.to_string()))?;
+        let model_bytes = store
+            .get_bytes()
+            .map_err(|e| checkpoint_error(&self.model_path(), e.to_string()))?;
+        write_bytes_atomically(&self.model_path(), &model_bytes)?;
+        let optim_bytes = optimizer
+            .into_bytes()
+            .map_err(|e| checkpoint_error(&self.optimizer_path(), e.to_string()))?;
+        write_bytes_atomically(&self.optimizer_path(), &optim_bytes)?;
+        let json = serde_json::to_vec_pretty(progress)
+            .map_err(|e| checkpoint_error(&self.progress_path(), e.to_string()))?;
+        write_bytes_atomically(&self.progress_path(), &json)?;
+        Ok(())
+    }
+
+    /// Loads the model weights into `module` (keeping the parameter ids the
+    /// optimizer state refers to), the optimizer state into `optimizer`, and
+    /// the progress.
+    pub fn load<M: Module, P: for<'de> Deserialize<'de>>(
+        &self,
+        mut module: M,
+        optimizer: ModuleOptimizer,
+    ) -> Result<(M, ModuleOptimizer, P)> {
+        let read = |p: &Path| std::fs::read(p).map_err(|e| mocap_core::Error::io(p, e));
+        let model_bytes = read(&self.model_path())?;
+        let mut store = BurnpackStore::from_bytes(Some(Bytes::from_bytes_vec(model_bytes)));
+        let result = module
+            .load_from(&mut store)
+            .map_err(|e| checkpoint_error(&self.model_path(), e.to_string()))?;
+        if !result.is_success() || !result.missing.is_empty() {
+            return Err(checkpoint_error(
+                &self.model_path(),
+                "the saved weights do not fit the model configuration",
+            ));
+        }
+        let optimizer = optimizer
+            .from_bytes(Bytes::from_bytes_vec(read(&self.optimizer_path())?))
+            .map_err(|e| checkpoint_error(&self.optimizer_path(), e.to_string()))?;
+        let progress = serde_json::from_slice(&read(&self.progress_path())?)
+            .map_err(|e| checkpoint_error(&self.progress_path(), e.to_string()))?;
+        Ok((module, optimizer, progress))
+    }
+}
