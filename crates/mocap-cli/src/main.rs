@@ -34,6 +34,10 @@ enum Command {
     Positions(commands::positions::Args),
     /// Motion retrieval by example: index a labelled library, query it, evaluate.
     Search(commands::search::Args),
+    /// Play motions in a local web viewer (127.0.0.1).
+    View(commands::view::ViewArgs),
+    /// Draw motions as a filmstrip PNG or an animated GIF.
+    Render(commands::view::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +48,8 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(args, &options),
         Command::Positions(args) => commands::positions::run(args, &options),
         Command::Search(args) => commands::search::run(args, &options),
+        Command::View(args) => commands::view::view(args, &options),
+        Command::Render(args) => commands::view::render(args, &options),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,6 +5,7 @@ pub mod convert;
 pub mod info;
 pub mod positions;
 pub mod search;
+pub mod view;
 
 use std::io::Write;
 use std::path::Path;
