@@ -13,7 +13,7 @@ with the standard library only), and checks what a person would:
 - hovering a joint names it;
 - a screenshot is not blank: the motions' colours are on it.
 
-Usage: check_viewer.py --viewer PATH_TO_VIEW_BINARY [--out DIR] FILE.bvh...
+Usage: check_viewer.py --viewer PATH_TO_MOCAP_BINARY [--out DIR] FILE.bvh...
 Prints one line per check and "N passed, N failed"; exits 1 on a failure.
 """
 
@@ -222,7 +222,7 @@ class Checks:
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("--viewer", required=True, help="the viewer binary (mocap-view's `view` example)")
+    parser.add_argument("--viewer", required=True, help="the mocap binary (run as `mocap view`)")
     parser.add_argument("--chromium", default="/usr/bin/chromium")
     parser.add_argument("--chromedriver", default="/usr/bin/chromedriver")
     parser.add_argument("--out", default=None, help="folder for the screenshot")

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Browser test of `mocap view` (the mocap-view crate's viewer) in a real
-# headless Chromium: installs Debian's chromium and chromium-driver when they
+# headless Chromium (run as `mocap view`): installs Debian's chromium and chromium-driver when they
 # are missing, builds the viewer, and runs check_viewer.py on the bundled
 # sample, a second Bandai take when the shared data is there, and a small
 # synthetic fused capture with confidence (written by the script).
@@ -20,10 +20,10 @@ if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver python3 >/dev/null
 fi
 
-echo "== building the viewer"
-cargo build -q -p mocap-view --example view
+echo "== building mocap"
+cargo build -q -p mocap-cli
 TARGET_DIR="${CARGO_TARGET_DIR:-target}"
-VIEWER="$TARGET_DIR/debug/examples/view"
+VIEWER="$TARGET_DIR/debug/mocap"
 
 DATA="${MOCAP_SHARED_DATA:-../shared/data}"
 FILES=(samples/dataset-1_walk_normal_001.bvh)
