@@ -13,28 +13,36 @@ if [ ! -x "$venv/bin/python" ]; then
     "$venv/bin/pip" install --quiet bvhio
 fi
 mapfile -t files < <(find "$data" -name '*.bvh' | sort)
-cargo build --release --quiet -p mocap-core --example bench_core
+cargo build --release --quiet -p mocap-core --example bench_core --example bvh_peak_memory
 ours=$(target/release/examples/bench_core "${files[@]}")
+# Peak memory on a ~300 MB synthetic take (repeated frames of a Bandai file).
+memory=$(target/release/examples/bvh_peak_memory --runs 1 2>&1 | grep '^run 1')
 # bvhio is single-threaded pure Python; give it the same files, cache warm.
 "$venv/bin/python" bench/bvhio_parse.py "${files[@]:0:5}" >/dev/null
 theirs=$("$venv/bin/python" bench/bvhio_parse.py "${files[@]}")
-python3 - "$ours" "$theirs" "$data" <<'PY'
+python3 - "$ours" "$theirs" "$data" "$memory" <<'PY'
 import json, platform, subprocess, sys, datetime
-ours, theirs, data = json.loads(sys.argv[1]), json.loads(sys.argv[2]), sys.argv[3]
+ours, theirs, data, memory = json.loads(sys.argv[1]), json.loads(sys.argv[2]), sys.argv[3], sys.argv[4]
 cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), platform.processor())
 ratio = ours["parse_mb_per_s"] / theirs["mb_per_s"]
 fk = ours["fk_transforms_per_s"]
 text = f"""# Core benchmark
 
 Made by `bench/core.sh {data}` on {datetime.date.today()}, machine: {cpu}, {subprocess.getoutput('nproc')} cores.
-Data: {ours['files']} BVH files, {ours['bytes']/1e6:.1f} MB, {ours['frames']} frames (Bandai Namco, 23 joints x 6 channels).
-All numbers single-threaded, files in the page cache, best of 3 (parse, write) or 5 (FK) passes.
+Data: {ours['files']} BVH files, {ours['bytes']/1e6:.1f} MB, {ours['frames']} frames (Bandai Namco, 22 joints x 6 channels).
+All numbers single-threaded CPU time of the working thread (fair on a shared machine), files in the page cache;
+ours best of 3 (parse, write) or 5 (FK) passes, bvhio one pass after a warm-up on 5 files.
 
 | measure | mocap | bvhio ({theirs['tool']}) | ratio |
 | --- | ---: | ---: | ---: |
 | BVH parse throughput (MB/s of text) | {ours['parse_mb_per_s']:.1f} | {theirs['mb_per_s']:.2f} | {ratio:.0f}x |
 | BVH write throughput (MB/s of text, to memory) | {ours['write_mb_per_s']:.1f} | - | - |
 | forward kinematics (joint transforms / s) | {fk/1e6:.1f} M | - | - |
+
+Large files: `target/release/examples/bvh_peak_memory --runs 1` (a ~300 MB take made by repeating the frames
+of the longest Bandai file, parsed once, wall time):
+
+    {memory}
 
 Targets (issue 2): parse >= 30x bvhio's MB/s: {'met' if ratio >= 30 else 'NOT met'}; FK >= 20 M joint transforms/s on one core: {'met' if fk >= 20e6 else 'NOT met'}.
 """
