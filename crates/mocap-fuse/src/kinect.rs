@@ -4,43 +4,27 @@
 //! Joint indices are those of the Kinect for Windows SDK 2.0 `JointType`
 //! enumeration, which is also the joint order of NTU RGB+D `.skeleton` files.
 //!
-//! Note: `mocap_core::bodymap` is planned to carry the Kinect v2 layout; until
-//! it lands there this crate keeps its own copy here (one place, used by the
-//! whole crate), to be replaced by a re-export.
+//! Joint names and parents come from `mocap_core::bodymap::KINECT_V2_JOINTS`;
+//! this module adds what fusion needs on top (indices by name, a
+//! parent-before-child order, mirror pairs, tracking states).
 
+use mocap_core::bodymap::KINECT_V2_JOINTS;
 use serde::{Deserialize, Serialize};
 
 /// Number of joints in a Kinect v2 body.
 pub const JOINT_COUNT: usize = 25;
 
-/// Joint names in SDK order.
-pub const JOINT_NAMES: [&str; JOINT_COUNT] = [
-    "SpineBase",
-    "SpineMid",
-    "Neck",
-    "Head",
-    "ShoulderLeft",
-    "ElbowLeft",
-    "WristLeft",
-    "HandLeft",
-    "ShoulderRight",
-    "ElbowRight",
-    "WristRight",
-    "HandRight",
-    "HipLeft",
-    "KneeLeft",
-    "AnkleLeft",
-    "FootLeft",
-    "HipRight",
-    "KneeRight",
-    "AnkleRight",
-    "FootRight",
-    "SpineShoulder",
-    "HandTipLeft",
-    "ThumbLeft",
-    "HandTipRight",
-    "ThumbRight",
-];
+/// Joint names in SDK order (from [`KINECT_V2_JOINTS`], the one copy of
+/// the layout).
+pub const JOINT_NAMES: [&str; JOINT_COUNT] = {
+    let mut names = [""; JOINT_COUNT];
+    let mut n = 0;
+    while n < JOINT_COUNT {
+        names[n] = KINECT_V2_JOINTS[n].0;
+        n += 1;
+    }
+    names
+};
 
 /// Indices of the joints, for readable code.
 pub mod joint {
@@ -74,34 +58,16 @@ pub mod joint {
 use joint::*;
 
 /// Parent of each joint in the Kinect v2 bone list (SDK sample
-/// `BodyBasics`); `None` for the root, `SpineBase`.
-pub const PARENTS: [Option<usize>; JOINT_COUNT] = [
-    None,                 // SpineBase
-    Some(SPINE_BASE),     // SpineMid
-    Some(SPINE_SHOULDER), // Neck
-    Some(NECK),           // Head
-    Some(SPINE_SHOULDER), // ShoulderLeft
-    Some(SHOULDER_LEFT),  // ElbowLeft
-    Some(ELBOW_LEFT),     // WristLeft
-    Some(WRIST_LEFT),     // HandLeft
-    Some(SPINE_SHOULDER), // ShoulderRight
-    Some(SHOULDER_RIGHT), // ElbowRight
-    Some(ELBOW_RIGHT),    // WristRight
-    Some(WRIST_RIGHT),    // HandRight
-    Some(SPINE_BASE),     // HipLeft
-    Some(HIP_LEFT),       // KneeLeft
-    Some(KNEE_LEFT),      // AnkleLeft
-    Some(ANKLE_LEFT),     // FootLeft
-    Some(SPINE_BASE),     // HipRight
-    Some(HIP_RIGHT),      // KneeRight
-    Some(KNEE_RIGHT),     // AnkleRight
-    Some(ANKLE_RIGHT),    // FootRight
-    Some(SPINE_MID),      // SpineShoulder
-    Some(HAND_LEFT),      // HandTipLeft
-    Some(WRIST_LEFT),     // ThumbLeft
-    Some(HAND_RIGHT),     // HandTipRight
-    Some(WRIST_RIGHT),    // ThumbRight
-];
+/// `BodyBasics`, as [`KINECT_V2_JOINTS`]); `None` for the root, `SpineBase`.
+pub const PARENTS: [Option<usize>; JOINT_COUNT] = {
+    let mut parents = [None; JOINT_COUNT];
+    let mut n = 0;
+    while n < JOINT_COUNT {
+        parents[n] = KINECT_V2_JOINTS[n].1;
+        n += 1;
+    }
+    parents
+};
 
 /// The joints in an order where every parent comes before its children (the
 /// SDK order does not: `SpineShoulder`, index 20, is the parent of `Neck`).

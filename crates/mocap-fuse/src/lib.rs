@@ -19,9 +19,18 @@
 //! - [`body`]: the person measured beforehand (bone lengths, joint ranges);
 //! - [`confidence`]: the confidence terms;
 //! - [`fusion`]: the weighted fusion and what we add to it;
+//! - [`offline`]: recordings put on a common clock and fused;
+//! - [`net`]: the UDP datagrams, the fusion server and the sender;
+//! - [`calib`], [`align`], [`ply`]: sensor poses, their file, and finding
+//!   them (point pairs, ICP on room scans, the body seen by two sensors);
+//! - [`bvh`]: fused joints as a BVH on a fitted skeleton;
+//! - [`sim`]: a Kinect v2 simulator on ground-truth takes;
+//! - [`eval`]: evaluation against ground truth, and without it
+//!   (bone-length consistency of real captures).
 
 pub mod align;
 pub mod body;
+pub mod bvh;
 pub mod calib;
 pub mod confidence;
 pub mod eval;
@@ -29,5 +38,6 @@ pub mod fusion;
 pub mod kinect;
 pub mod net;
 pub mod offline;
+pub mod ply;
 pub mod recording;
 pub mod sim;

@@ -59,6 +59,9 @@ pub struct SensorModel {
     pub fov_degrees: (f32, f32),
     /// Nearest and farthest tracked depth (metres).
     pub range: (f32, f32),
+    /// Nearest and farthest depth of the room scans (metres): the depth
+    /// camera measures beyond the body-tracking range, to 8 m.
+    pub scan_range: (f32, f32),
     /// Standard deviation of the constant per-joint bias of Tracked joints (m).
     pub bias_sigma: f32,
     /// Slowly varying error of Tracked joints: `sigma = a + b z^2` (m, z in m).
@@ -90,6 +93,7 @@ impl Default for SensorModel {
         SensorModel {
             fov_degrees: (70.6, 60.0),
             range: (0.5, 4.5),
+            scan_range: (0.5, 8.0),
             bias_sigma: 0.015,
             tracked_sigma: (0.006, 0.0015),
             tracked_tau: 0.15,
@@ -628,8 +632,14 @@ pub struct SurfacePoint {
 
 /// Points of a simple room around the capture area (world space): a floor
 /// 7 x 7 m, four walls 2.6 m high, a table, a cabinet and a pillar (boxes
-/// break the sliding symmetry of plain walls that ICP cannot resolve),
-/// sampled every `spacing` metres.
+/// break the sliding symmetry of plain walls), sampled every `spacing`
+/// metres.
+///
+/// Note: sensors placed around the person look inwards, so each sees the
+/// part of the room behind the others; what two such sensors both see is
+/// little more than the floor around the person. Their scans leave sliding
+/// and turning on the floor free, which ICP reports rather than guesses
+/// ([`crate::align::IcpResult::unconstrained`]).
 pub fn room_points(spacing: f32, seed: u64) -> Vec<SurfacePoint> {
     let mut rng = StdRng::seed_from_u64(seed);
     let mut out = Vec::new();
@@ -671,7 +681,7 @@ pub fn room_points(spacing: f32, seed: u64) -> Vec<SurfacePoint> {
 }
 
 /// What sensor `pose` sees of the room: points in its field of view and
-/// range, on surfaces facing it, in its camera space, with depth noise along
+/// scan range, on surfaces facing it, in its camera space, with depth noise along
 /// the line of sight (`0.0015 z^2` m). Occlusion between room objects is not
 /// modelled.
 pub fn sensor_point_cloud(
@@ -691,8 +701,8 @@ pub fn sensor_point_cloud(
         .filter(|s| s.normal.dot(pose.translation - s.position) > 0.0)
         .filter_map(|s| {
             let p = inverse.apply(s.position);
-            let ok = p.z > model.range.0
-                && p.z < model.range.1 + 1.0
+            let ok = p.z > model.scan_range.0
+                && p.z < model.scan_range.1
                 && (p.x / p.z).abs() < half_h
                 && (p.y / p.z).abs() < half_v;
             ok.then(|| p * (1.0 + n.sample(&mut rng) * 0.0015 * p.z))
