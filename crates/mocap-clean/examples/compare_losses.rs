@@ -5,6 +5,7 @@
 //! cargo run --release -p mocap-clean --example compare_losses -- \
 //!     --data ../shared/data/bandai --out-dir bench/clean/compare \
 //!     [--seeds 1,2,3] [--epochs 8] [--steps 20] [--batch 512] [--auc-epochs 3] [--max-train-takes N]
+//!     [--replot]   (only redraw validation_curves.png from summary.json)
 
 use std::path::PathBuf;
 
@@ -17,8 +18,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut out_dir = PathBuf::from("bench/clean/compare");
     let mut seeds: Vec<u64> = vec![1, 2, 3];
     let mut auc_epochs = 3;
+    let mut replot = false;
     let mut i = 0;
     while i < args.len() {
+        if args[i] == "--replot" {
+            replot = true;
+            i += 1;
+            continue;
+        }
         let v = args
             .get(i + 1)
             .cloned()
@@ -38,6 +45,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         i += 2;
     }
     std::fs::create_dir_all(&out_dir)?;
+    if replot {
+        // Redraw the overlay from a finished comparison's summary.json.
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out_dir.join("summary.json"))?)?;
+        let series: Vec<Series> = summary["runs"]
+            .as_array()
+            .ok_or("summary.json without runs")?
+            .iter()
+            .map(|r| {
+                let points = r["valid_mse"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .enumerate()
+                    .map(|(i, v)| ((i + 1) as f64, v.as_f64().unwrap_or(f64::NAN)))
+                    .collect();
+                Series::new(
+                    format!("{} seed {}", r["loss"].as_str().unwrap_or("?"), r["seed"]),
+                    points,
+                )
+            })
+            .collect();
+        plot(&out_dir, &series)?;
+        return Ok(());
+    }
     let mut series = Vec::new();
     let mut rows = Vec::new();
     for derivative in [false, true] {
@@ -75,17 +107,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
+    plot(&out_dir, &series)?;
+    let summary = serde_json::json!({ "auc_epochs": auc_epochs, "runs": rows });
+    let text = serde_json::to_string_pretty(&summary)?;
+    mocap_core::io::atomic::write_bytes_atomically(&out_dir.join("summary.json"), text.as_bytes())?;
+    println!("{text}");
+    Ok(())
+}
+
+fn plot(out_dir: &std::path::Path, series: &[Series]) -> Result<(), Box<dyn std::error::Error>> {
     plot_lines(
         &out_dir.join("validation_curves.png"),
-        &series,
+        series,
         &PlotOptions {
             y_label: "validation MSE (6D features)".into(),
             ..PlotOptions::new("Validation loss: plain MSE vs derivative loss")
         },
     )?;
-    let summary = serde_json::json!({ "auc_epochs": auc_epochs, "runs": rows });
-    let text = serde_json::to_string_pretty(&summary)?;
-    mocap_core::io::atomic::write_bytes_atomically(&out_dir.join("summary.json"), text.as_bytes())?;
-    println!("{text}");
     Ok(())
 }

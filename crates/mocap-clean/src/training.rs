@@ -209,23 +209,35 @@ impl<'a> WindowSampler<'a> {
         Ok((noisy, clean))
     }
 
-    /// A batch as `[batch, channels, frames]` tensors data (noisy, clean).
+    /// A batch as `[batch, channels, frames]` tensor data (noisy, clean).
+    ///
+    /// Each sample has its own generator seeded from `rng`, so the batch is
+    /// the same whatever the number of threads that make it.
     pub fn batch<R: Rng + ?Sized>(&self, rng: &mut R, size: usize) -> Result<(Vec<f32>, Vec<f32>)> {
+        use rayon::prelude::*;
         let c = self.layout.channels();
         let t = self.frames;
+        let seeds: Vec<u64> = (0..size).map(|_| rng.random::<u64>()).collect();
+        let samples = seeds
+            .par_iter()
+            .map(|&seed| {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                let (noisy, clean) = self.sample_motion(&mut rng)?;
+                let mut xf = self.layout.encode(&noisy);
+                let mut yf = self.layout.encode(&clean);
+                // Euler windows: the same whole turns off input and target.
+                let offsets = self.layout.recenter(&mut xf);
+                for frame in yf.chunks_mut(c) {
+                    for (v, o) in frame.iter_mut().zip(&offsets) {
+                        *v -= o;
+                    }
+                }
+                Ok((xf, yf))
+            })
+            .collect::<Result<Vec<_>>>()?;
         let mut x = vec![0.0; size * c * t];
         let mut y = vec![0.0; size * c * t];
-        for b in 0..size {
-            let (noisy, clean) = self.sample_motion(rng)?;
-            let mut xf = self.layout.encode(&noisy);
-            let mut yf = self.layout.encode(&clean);
-            // Euler windows: the same whole turns off input and target.
-            let offsets = self.layout.recenter(&mut xf);
-            for frame in yf.chunks_mut(c) {
-                for (v, o) in frame.iter_mut().zip(&offsets) {
-                    *v -= o;
-                }
-            }
+        for (b, (xf, yf)) in samples.iter().enumerate() {
             for f in 0..t {
                 for ch in 0..c {
                     x[(b * c + ch) * t + f] = xf[f * c + ch];
@@ -497,4 +509,77 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         data_seconds_per_step: run.data_seconds / steps_run.max(1) as f64,
         validation_input_mse,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::synthetic_motion_phase;
+    use mocap_core::io::bvh::write_bvh;
+
+    /// A folder of small synthetic takes and options for a tiny run.
+    fn tiny_setup(dir: &Path) -> TrainOptions {
+        let data = dir.join("data");
+        std::fs::create_dir_all(&data).unwrap();
+        for i in 0..30 {
+            let m = synthetic_motion_phase(40, 4, i as f32 * 0.37);
+            write_bvh(&data.join(format!("take_{i:02}.bvh")), &m).unwrap();
+        }
+        TrainOptions {
+            inputs: vec![data],
+            network: DenoiserConfig {
+                channels: 0,
+                width: 4,
+                levels: 1,
+                blocks: 1,
+                kernel: 3,
+                window: 8,
+            },
+            epochs: 2,
+            steps_per_epoch: 2,
+            batch_size: 8,
+            validation_windows: 8,
+            split: SplitFractions {
+                validation: 0.3,
+                test: 0.0,
+            },
+            ..TrainOptions::default()
+        }
+    }
+
+    #[test]
+    fn a_resumed_run_matches_an_uninterrupted_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = tiny_setup(dir.path());
+        let straight = TrainOptions {
+            out: dir.path().join("a.safetensors"),
+            ..base.clone()
+        };
+        let a = train(&straight).unwrap();
+        let first_half = TrainOptions {
+            out: dir.path().join("b.safetensors"),
+            epochs: 1,
+            ..base.clone()
+        };
+        train(&first_half).unwrap();
+        let resumed = TrainOptions {
+            epochs: 2,
+            resume: true,
+            ..first_half
+        };
+        let b = train(&resumed).unwrap();
+        assert_eq!(b.resumed_from_epoch, 1);
+        assert_eq!(a.history.epochs.len(), 2);
+        assert_eq!(b.history.epochs.len(), 2);
+        for (x, y) in a.history.epochs.iter().zip(&b.history.epochs) {
+            let tol = 1e-5 * x.valid_loss.abs().max(1e-3);
+            assert!((x.valid_loss - y.valid_loss).abs() < tol, "{x:?} vs {y:?}");
+            assert!((x.train_loss - y.train_loss).abs() < 1e-5 * x.train_loss.abs().max(1e-3));
+        }
+        // The model file says what it is and what it was trained on.
+        let header = mocap_nn::checkpoint::read_header(&b.model).unwrap();
+        assert_eq!(header.kind, CHECKPOINT_KIND);
+        assert_eq!(header.data["data"]["train_takes"], b.data.train_takes);
+        assert!(b.plot.is_file());
+    }
 }

@@ -145,6 +145,7 @@ fn draw(
                 .x_desc(&options.x_label)
                 .y_desc(&options.y_label)
                 .label_style(("sans-serif", 14))
+                .y_label_formatter(&|v: &f64| format_tick(*v))
                 .draw()
                 .map_err(|x| e(&x))?;
             for (i, s) in series.iter().enumerate() {
@@ -173,7 +174,9 @@ fn draw(
                 .map_err(|x| e(&x))?;
         }};
     }
-    if options.log_y {
+    // A log axis only gets labels at powers of ten: use it for ranges of
+    // more than a decade.
+    if options.log_y && y0 > 0.0 && y1 / y0 > 10.0 {
         finish!(builder
             .build_cartesian_2d(x0..x1, (y0 * 0.95..y1 * 1.05).log_scale())
             .map_err(|x| e(&x))?);
@@ -185,6 +188,16 @@ fn draw(
     }
     root.present().map_err(|x| e(&x))?;
     Ok(())
+}
+
+/// A short tick label: 3 significant digits, scientific for tiny numbers.
+fn format_tick(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e5) {
+        format!("{v:.2e}")
+    } else {
+        let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{v:.digits$}")
+    }
 }
 
 #[cfg(test)]
