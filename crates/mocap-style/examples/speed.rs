@@ -1,0 +1,89 @@
+//! Time to restyle a 10-second clip, and the share of each stage.
+//!
+//! ```text
+//! cargo run --release -p mocap-style --example speed -- SOURCE STYLE_CLIP [--model M] [--runs 20]
+//! ```
+//!
+//! The source is cut (or its frames used) to its first 10 seconds; each run
+//! prepares and encodes the style clip and its mirror, then restyles, as
+//! `mocap style apply` does (file reading and writing excluded). Prints the
+//! median of every stage over the runs, for elastic and fixed patches.
+
+use std::path::PathBuf;
+
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::ops::trim;
+use mocap_nn::device::DeviceChoice;
+use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
+use mocap_style::convert::{ConvertOptions, Method};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut paths = Vec::new();
+    let mut model_path = None;
+    let mut runs = 20;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--model" => model_path = args.next().map(PathBuf::from),
+            "--runs" => runs = args.next().expect("--runs N").parse()?,
+            _ => paths.push(PathBuf::from(a)),
+        }
+    }
+    let [source, style] = &paths[..] else {
+        return Err("usage: speed SOURCE STYLE_CLIP [--model M] [--runs N]".into());
+    };
+    let model = load_model(model_path.as_deref(), DeviceChoice::Cpu)?;
+    let source = read_bvh(source)?;
+    let frames = ((10.0 * source.fps()).round() as usize).min(source.frame_count());
+    let source = trim(&source, 0..frames)?;
+    let style_motion = read_bvh(style)?;
+    println!(
+        "source: {} frames ({:.2} s at {:.0} fps); style clip: {} frames; {} runs; threads: {}",
+        source.frame_count(),
+        source.duration(),
+        source.fps(),
+        style_motion.frame_count(),
+        runs,
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
+    println!(
+        "| method | total (ms) | prepare | encode | match | decode | compose | output frames |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    for method in [Method::ElasticPatches, Method::FixedPatches] {
+        let mut all: Vec<StageTimings> = Vec::new();
+        let mut out_frames = 0;
+        for _ in 0..runs + 1 {
+            let mut t = StageTimings::default();
+            let clip = prepare_style(&model, &style_motion, "style", &mut t)?;
+            let options = ConvertOptions {
+                method,
+                ..ConvertOptions::default()
+            };
+            let r = restyle(&model, &source, &[(&clip, 1.0)], &options, t)?;
+            out_frames = r.motion.frame_count();
+            all.push(r.timings);
+        }
+        all.remove(0); // warm-up
+        let ms = |f: &dyn Fn(&StageTimings) -> f64| 1000.0 * median(all.iter().map(f).collect());
+        let total = ms(&|t| t.total());
+        let share = |v: f64| format!("{v:.1} ms ({:.0}%)", 100.0 * v / total);
+        println!(
+            "| {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            method.name(),
+            total,
+            share(ms(&|t| t.prepare)),
+            share(ms(&|t| t.encode)),
+            share(ms(&|t| t.matching)),
+            share(ms(&|t| t.decode)),
+            share(ms(&|t| t.compose)),
+            out_frames
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,396 @@
+//! Restyling clips: `mocap style apply`.
+//!
+//! [`restyle`] works on motions in memory (the evaluation and the benchmark
+//! call it); [`apply`] reads the files, restyles, and writes the output.
+//!
+//! The output keeps the source's skeleton (bone lengths) and frame rate.
+//! The root's horizontal path and heading come from the source (time-warped
+//! with the patches), its height from the style clip, scaled by the ratio of
+//! the two performers' leg lengths (heights are measured from the world
+//! origin, i.e. the ground of the capture). A style clip must be of the same
+//! rig as the source (same joint names and hierarchy; other bone lengths are
+//! fine); another rig is refused with a message that names the differences:
+//! retargeting between rigs is not done here.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::io::write_motion;
+use mocap_core::ops::resample_fps;
+use mocap_core::rotation::Vec3;
+use mocap_core::Motion;
+use mocap_nn::device::DeviceChoice;
+use serde::{Deserialize, Serialize};
+
+use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, StyleInput};
+use crate::data::mirrored;
+use crate::features::{compose, decompose, sample_frames, RootTrack};
+use crate::train::StyleModel;
+use crate::{invalid, Result};
+
+/// Options of `mocap style apply`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ApplyOptions {
+    pub source: PathBuf,
+    /// The example clip of the style.
+    pub style: PathBuf,
+    pub out: PathBuf,
+    /// The model file; `None`: the shipped default model.
+    pub model: Option<PathBuf>,
+    /// 1: full style; 0: the source (default 1).
+    pub strength: f32,
+    /// `ElasticPatches` (default); `FixedPatches` for `--no-elastic`.
+    pub method: Method,
+    /// Seconds over which the style fades in (0: none).
+    pub fade_in_seconds: f64,
+    /// A second style clip and its weight in the blend (`--blend CLIP:0.5`).
+    pub blend: Option<(PathBuf, f32)>,
+    /// Patch length in frames (default 32).
+    pub patch: usize,
+    pub device: DeviceChoice,
+}
+
+impl ApplyOptions {
+    /// Default options for these files.
+    pub fn new(
+        source: impl Into<PathBuf>,
+        style: impl Into<PathBuf>,
+        out: impl Into<PathBuf>,
+    ) -> ApplyOptions {
+        ApplyOptions {
+            source: source.into(),
+            style: style.into(),
+            out: out.into(),
+            model: None,
+            strength: 1.0,
+            method: Method::ElasticPatches,
+            fade_in_seconds: 0.0,
+            blend: None,
+            patch: ConvertOptions::default().patch,
+            device: DeviceChoice::Cpu,
+        }
+    }
+}
+
+/// Parses `--blend CLIP:WEIGHT` (the weight of the other style, in [0, 1]).
+pub fn parse_blend(text: &str) -> Result<(PathBuf, f32)> {
+    let (path, weight) = text.rsplit_once(':').ok_or_else(|| {
+        invalid(format!(
+            "--blend `{text}`: expected OTHER_STYLE_CLIP:WEIGHT, e.g. old.bvh:0.5"
+        ))
+    })?;
+    let weight: f32 = weight.trim().parse().map_err(|_| {
+        invalid(format!(
+            "--blend `{text}`: the weight `{weight}` is not a number"
+        ))
+    })?;
+    if !(0.0..=1.0).contains(&weight) {
+        return Err(invalid(format!(
+            "--blend `{text}`: the weight must be between 0 and 1"
+        )));
+    }
+    Ok((PathBuf::from(path), weight))
+}
+
+/// Seconds spent in each stage of a restyle.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageTimings {
+    /// Rig checks, resampling, mirroring the style, rotations to features.
+    pub prepare: f64,
+    /// The encoder on the source and the style clips (and mirrors).
+    pub encode: f64,
+    /// Whitening, patch matching, blending, colouring.
+    pub matching: f64,
+    /// The decoder.
+    pub decode: f64,
+    /// Features back to rotations and the output motion.
+    pub compose: f64,
+}
+
+impl StageTimings {
+    pub fn total(&self) -> f64 {
+        self.prepare + self.encode + self.matching + self.decode + self.compose
+    }
+}
+
+/// A style clip ready to convert to: latent codes and root heights of the
+/// clip and its mirror.
+#[derive(Debug, Clone)]
+pub struct StyleClip {
+    /// (latent codes, pelvis height per frame) of the clip and its mirror.
+    pub sequences: Vec<(Latents, Vec<f32>)>,
+    /// Rest leg length of the style performer (heights are scaled by it).
+    pub leg_length: f32,
+}
+
+/// Encodes a style clip and its mirror; `what` names it in errors.
+pub fn prepare_style(
+    model: &StyleModel,
+    motion: &Motion,
+    what: &str,
+    timings: &mut StageTimings,
+) -> Result<StyleClip> {
+    let t = Instant::now();
+    let motion = model.prepare(motion, what)?;
+    let rig = &model.description.rig;
+    let mirror = mirrored(&motion)?;
+    let mut parts = Vec::new();
+    for m in [&motion, &mirror] {
+        let (rotations, root) = decompose(m, rig);
+        parts.push((model.features(&rotations), root.heights()));
+    }
+    timings.prepare += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut sequences = Vec::new();
+    for (features, heights) in parts {
+        sequences.push((model.encode(&features)?, heights));
+    }
+    timings.encode += t.elapsed().as_secs_f64();
+    Ok(StyleClip {
+        sequences,
+        leg_length: rig.leg_length(motion.skeleton()),
+    })
+}
+
+/// The result of [`restyle`].
+#[derive(Debug, Clone)]
+pub struct Restyled {
+    pub motion: Motion,
+    pub conversion: Conversion,
+    pub timings: StageTimings,
+}
+
+/// Restyles `source` (any frame rate; output at the same rate) to the
+/// weighted styles.
+pub fn restyle(
+    model: &StyleModel,
+    source: &Motion,
+    styles: &[(&StyleClip, f32)],
+    options: &ConvertOptions,
+    mut timings: StageTimings,
+) -> Result<Restyled> {
+    let rig = &model.description.rig;
+    let t = Instant::now();
+    let src = model.prepare(source, "source")?;
+    let (rotations, root) = decompose(&src, rig);
+    let features = model.features(&rotations);
+    let leg = rig.leg_length(src.skeleton());
+    // Style heights scaled to the source performer.
+    let scaled: Vec<Vec<(Latents, Vec<f32>)>> = styles
+        .iter()
+        .map(|(s, _)| {
+            let k = if s.leg_length > 0.0 {
+                leg / s.leg_length
+            } else {
+                1.0
+            };
+            s.sequences
+                .iter()
+                .map(|(l, h)| (l.clone(), h.iter().map(|x| x * k).collect()))
+                .collect()
+        })
+        .collect();
+    timings.prepare += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let latents = model.encode(&features)?;
+    timings.encode += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let inputs: Vec<StyleInput> = scaled
+        .iter()
+        .zip(styles)
+        .map(|(seqs, (_, w))| StyleInput {
+            sequences: seqs,
+            weight: *w,
+        })
+        .collect();
+    let conversion = convert(&latents, &root.heights(), &inputs, options)?;
+    timings.matching += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let decoded = model.decode(&conversion.latents)?;
+    timings.decode += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let out_rotations = model.description.normalization.rotations(&decoded);
+    let motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
+    let motion = if (motion.fps() - source.fps()).abs() > 1e-3 * source.fps() {
+        resample_fps(&motion, source.fps())?
+    } else {
+        motion
+    };
+    timings.compose += t.elapsed().as_secs_f64();
+    Ok(Restyled {
+        motion,
+        conversion,
+        timings,
+    })
+}
+
+/// The output motion: the source sampled along the time warp, with the
+/// decoded rotations, the source's horizontal path and heading, and the
+/// converted height.
+fn rebuild(
+    source: &Motion,
+    root: &RootTrack,
+    conversion: &Conversion,
+    rotations: &[mocap_core::rotation::Quat],
+    rig: &crate::features::RigLayout,
+) -> Result<Motion> {
+    let base = sample_frames(source, &conversion.source_time)?;
+    let mut pelvis: Vec<Vec3> = Vec::with_capacity(conversion.source_time.len());
+    let mut heading = Vec::with_capacity(conversion.source_time.len());
+    for (&t, &h) in conversion.source_time.iter().zip(&conversion.height) {
+        let (p, q) = root.sample(t);
+        pelvis.push(p - root.up * p.dot(root.up) + root.up * h);
+        heading.push(q);
+    }
+    compose(base, rig, rotations, &pelvis, &heading)
+}
+
+/// What `mocap style apply` reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ApplyReport {
+    pub source: PathBuf,
+    pub style: PathBuf,
+    pub blend: Option<(PathBuf, f32)>,
+    pub out: PathBuf,
+    pub model: String,
+    pub method: Method,
+    pub strength: f32,
+    pub fade_in_seconds: f64,
+    pub patch: usize,
+    pub source_frames: usize,
+    pub output_frames: usize,
+    pub fps: f64,
+    /// Output duration over source duration (1 without elastic patches).
+    pub time_scale: f64,
+    /// Mean source frames per patch over the patch length (main series).
+    pub mean_patch_stretch: f64,
+    /// Mean cosine similarity of the matched patches.
+    pub mean_similarity: f64,
+    pub timings: StageTimings,
+    /// Seconds reading the inputs and loading the model.
+    pub load_seconds: f64,
+    /// Seconds writing the output.
+    pub write_seconds: f64,
+}
+
+/// Loads the model of `options` (or the default one).
+pub fn load_model(model: Option<&Path>, device: DeviceChoice) -> Result<StyleModel> {
+    match model {
+        Some(p) => StyleModel::load(p, device),
+        None => StyleModel::default_model(device),
+    }
+}
+
+/// Restyles a file and writes the result (see the module docs).
+pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
+    let t = Instant::now();
+    let model = load_model(options.model.as_deref(), options.device)?;
+    let source = read_bvh(&options.source)?;
+    let style = read_bvh(&options.style)?;
+    let blend = match &options.blend {
+        Some((path, w)) => Some((read_bvh(path)?, *w, path)),
+        None => None,
+    };
+    let load_seconds = t.elapsed().as_secs_f64();
+    let mut timings = StageTimings::default();
+    let style_clip = prepare_style(
+        &model,
+        &style,
+        &options.style.display().to_string(),
+        &mut timings,
+    )?;
+    let other = match &blend {
+        Some((motion, _, path)) => Some(prepare_style(
+            &model,
+            motion,
+            &path.display().to_string(),
+            &mut timings,
+        )?),
+        None => None,
+    };
+    let mut styles = vec![(&style_clip, 1.0 - blend.as_ref().map_or(0.0, |b| b.1))];
+    if let (Some(o), Some((_, w, _))) = (&other, &blend) {
+        styles.push((o, *w));
+    }
+    let convert_options = ConvertOptions {
+        method: options.method,
+        patch: options.patch,
+        strength: options.strength,
+        fade_in_frames: (options.fade_in_seconds * model.description.fps) as f32,
+        ..ConvertOptions::default()
+    };
+    // Check the source's rig first so its message names the source file.
+    model
+        .description
+        .rig
+        .check_skeleton(source.skeleton(), &options.source.display().to_string())?;
+    let restyled = restyle(&model, &source, &styles, &convert_options, timings)?;
+    let t = Instant::now();
+    write_motion(&options.out, &restyled.motion)?;
+    let write_seconds = t.elapsed().as_secs_f64();
+    let main: Vec<_> = restyled
+        .conversion
+        .matches
+        .iter()
+        .filter(|m| m.series == 1)
+        .collect();
+    let mean_patch_stretch = if main.is_empty() {
+        1.0
+    } else {
+        main.iter().map(|m| m.source_length as f64).sum::<f64>()
+            / (main.len() * options.patch) as f64
+    };
+    let sims: Vec<f64> = restyled
+        .conversion
+        .matches
+        .iter()
+        .flat_map(|m| m.style.iter().map(|s| s.2 as f64))
+        .collect();
+    Ok(ApplyReport {
+        source: options.source.clone(),
+        style: options.style.clone(),
+        blend: options.blend.clone(),
+        out: options.out.clone(),
+        model: options
+            .model
+            .as_ref()
+            .map_or("built-in default".to_string(), |p| p.display().to_string()),
+        method: options.method,
+        strength: options.strength,
+        fade_in_seconds: options.fade_in_seconds,
+        patch: options.patch,
+        source_frames: source.frame_count(),
+        output_frames: restyled.motion.frame_count(),
+        fps: restyled.motion.fps(),
+        time_scale: restyled.motion.duration() / source.duration(),
+        mean_patch_stretch,
+        mean_similarity: if sims.is_empty() {
+            f64::NAN
+        } else {
+            sims.iter().sum::<f64>() / sims.len() as f64
+        },
+        timings: restyled.timings,
+        load_seconds,
+        write_seconds,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blend_argument() {
+        let (p, w) = parse_blend("clips/old walk.bvh:0.25").unwrap();
+        assert_eq!(p, PathBuf::from("clips/old walk.bvh"));
+        assert_eq!(w, 0.25);
+        assert!(parse_blend("old.bvh").is_err());
+        assert!(parse_blend("old.bvh:x").is_err());
+        assert!(parse_blend("old.bvh:1.5").is_err());
+    }
+}

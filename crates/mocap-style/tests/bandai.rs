@@ -1,0 +1,166 @@
+//! Style transfer with the shipped default model on Bandai Namco takes.
+//!
+//! The data is found at `<workspace>/../shared/data` or `$MOCAP_SHARED_DATA`;
+//! without it the tests print a note and pass.
+
+use std::path::PathBuf;
+
+use mocap_core::forward_kinematics;
+use mocap_core::io::bvh::read_bvh;
+use mocap_nn::device::DeviceChoice;
+use mocap_style::apply::{apply, prepare_style, restyle, ApplyOptions, StageTimings};
+use mocap_style::convert::{ConvertOptions, Method};
+use mocap_style::eval::{foot_skating, gait_period};
+use mocap_style::features::RigLayout;
+use mocap_style::train::StyleModel;
+
+fn bandai(set: &str, name: &str) -> Option<PathBuf> {
+    let dir = std::env::var_os("MOCAP_SHARED_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    let path = dir.join("bandai").join(set).join(name);
+    if path.is_file() {
+        Some(path)
+    } else {
+        eprintln!("note: {} not found; skipping", path.display());
+        None
+    }
+}
+
+/// The output keeps the source's skeleton and frame rate, follows the
+/// source's path, and a style clip with a slower stride (proud: about 1.7 s
+/// against 0.9 s for this happy walk) makes the output longer with elastic
+/// patches, with a period closer to the style's, but not with fixed ones.
+/// Both clips are held-out takes.
+#[test]
+fn restyled_walk_keeps_the_source_rig_and_takes_the_style_timing() {
+    let (Some(src), Some(sty)) = (
+        bandai("dataset-1", "dataset-1_walk_happy_002.bvh"),
+        bandai("dataset-1", "dataset-1_walk_proud_002.bvh"),
+    ) else {
+        return;
+    };
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let source = read_bvh(&src).unwrap();
+    let style = read_bvh(&sty).unwrap();
+    let mut t = StageTimings::default();
+    let clip = prepare_style(&model, &style, "style", &mut t).unwrap();
+    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
+    let p_source = gait_period(&source, &rig).unwrap();
+    let p_style = gait_period(&style, &rig).unwrap();
+    assert!(
+        p_style > p_source * 1.2,
+        "elderly walk is slower: {p_style} vs {p_source}"
+    );
+
+    let elastic = restyle(
+        &model,
+        &source,
+        &[(&clip, 1.0)],
+        &ConvertOptions::default(),
+        t,
+    )
+    .unwrap();
+    let out = &elastic.motion;
+    assert_eq!(out.skeleton(), source.skeleton());
+    assert!((out.fps() - source.fps()).abs() < 1e-6);
+    assert!(out.values().iter().all(|v| v.is_finite()));
+    let scale = out.duration() / source.duration();
+    assert!(
+        scale > 1.05,
+        "elastic output should be slower, duration ratio {scale}"
+    );
+    // The path: start and end where the source starts and ends (horizontally).
+    let a = forward_kinematics(&source);
+    let b = forward_kinematics(out);
+    let hips = rig.pelvis;
+    for (fa, fb) in [(0, 0), (a.frame_count - 1, b.frame_count - 1)] {
+        let d = a.position(fa, hips) - b.position(fb, hips);
+        let horizontal = (d.x * d.x + d.z * d.z).sqrt();
+        assert!(
+            horizontal < 5.0,
+            "pelvis {horizontal} cm off the source's path"
+        );
+    }
+    let p_out = gait_period(out, &rig).unwrap();
+    assert!(
+        (p_out - p_style).abs() < (p_source - p_style).abs(),
+        "output period {p_out} s should be closer to the style's {p_style} s than the source's {p_source} s"
+    );
+    let fixed = ConvertOptions {
+        method: Method::FixedPatches,
+        ..ConvertOptions::default()
+    };
+    let fixed = restyle(&model, &source, &[(&clip, 1.0)], &fixed, t).unwrap();
+    assert_eq!(fixed.motion.frame_count(), source.frame_count());
+}
+
+/// Restyled to another take of its own style, a walk keeps its feet about
+/// as planted as the source's (a wrong root height, heading or time warp
+/// makes them slide several times more).
+#[test]
+fn same_style_transfer_keeps_the_feet_planted() {
+    let (Some(src), Some(sty)) = (
+        bandai("dataset-1", "dataset-1_walk_happy_002.bvh"),
+        bandai("dataset-1", "dataset-1_walk_happy_001.bvh"),
+    ) else {
+        return;
+    };
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let source = read_bvh(&src).unwrap();
+    let mut t = StageTimings::default();
+    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
+    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
+    let out = restyle(&model, &source, &[(&clip, 1.0)], &ConvertOptions::default(), t).unwrap();
+    let (skate_out, skate_source) = (foot_skating(&out.motion, &rig), foot_skating(&source, &rig));
+    eprintln!("foot skating {skate_out} vs source {skate_source}");
+    assert!(skate_out < 2.0 * skate_source, "foot skating {skate_out} vs source {skate_source}");
+}
+
+#[test]
+fn apply_writes_a_readable_file_and_reports() {
+    let (Some(src), Some(sty), Some(other)) = (
+        bandai("dataset-1", "dataset-1_walk_normal_001.bvh"),
+        bandai("dataset-1", "dataset-1_walk_proud_002.bvh"),
+        bandai("dataset-1", "dataset-1_walk_tired_002.bvh"),
+    ) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("proud.bvh");
+    let mut options = ApplyOptions::new(&src, &sty, &out);
+    options.strength = 0.7;
+    options.fade_in_seconds = 1.0;
+    options.blend = Some((other, 0.3));
+    let report = apply(&options).unwrap();
+    let written = read_bvh(&out).unwrap();
+    assert_eq!(written.frame_count(), report.output_frames);
+    assert!(report.mean_similarity > 0.0 && report.mean_similarity <= 1.0 + 1e-4);
+    assert!(report.timings.total() > 0.0);
+}
+
+/// A style clip of another rig is refused with a message naming the file.
+#[test]
+fn a_style_clip_of_another_rig_is_refused() {
+    let Some(src) = bandai("dataset-1", "dataset-1_walk_normal_001.bvh") else {
+        return;
+    };
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/parser-cases");
+    let Some(other) = std::fs::read_dir(&dir).ok().and_then(|entries| {
+        entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.extension().is_some_and(|e| e == "bvh") && read_bvh(p).is_ok())
+    }) else {
+        eprintln!("note: no parser-case BVH; skipping");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let options = ApplyOptions::new(&src, &other, dir.path().join("out.bvh"));
+    let err = apply(&options).unwrap_err().to_string();
+    assert!(err.contains(&other.display().to_string()), "{err}");
+    assert!(
+        err.contains("another rig") || err.contains("body parts"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out.bvh").exists());
+}
