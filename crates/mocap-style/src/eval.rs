@@ -153,7 +153,8 @@ pub struct SetReport {
     pub contents: Vec<String>,
     pub classifier_clips: usize,
     pub test_clips: usize,
-    /// Classifier accuracy on the real held-out clips (their ceiling).
+    /// Classifier accuracy on the real held-out clips (their ceiling); for
+    /// style, over the held-out clips of the contents it was trained on.
     pub classifier_style_accuracy: f64,
     pub classifier_content_accuracy: f64,
     /// Chance level of the style classifier (1 / number of styles).
@@ -521,11 +522,16 @@ fn evaluate_set(
     contents.sort();
     contents.dedup();
 
-    // Classifier ceilings on the real held-out clips.
+    // Classifier ceilings on the real held-out clips (for style, over the
+    // held-out clips of the contents the style classifier was trained on).
     let mut style_hits = 0;
+    let mut style_tests = 0;
     let mut content_hits = 0;
     for c in &test_clips {
-        style_hits += (style_classifier.predict(&c.motion)? == c.labels.style) as usize;
+        if options.classifier_filter.accepts(&c.labels) {
+            style_tests += 1;
+            style_hits += (style_classifier.predict(&c.motion)? == c.labels.style) as usize;
+        }
         content_hits += (content_classifier.predict(&c.motion)? == c.labels.content) as usize;
     }
     let rig = &model.description.rig;
@@ -566,14 +572,12 @@ fn evaluate_set(
         .collect();
 
     let mut pairs = Vec::new();
-    let mut filmstrips = Vec::new();
     let mut source_rows = Vec::new();
     for source in &sources {
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
                 continue;
             }
-            let mut outputs: Vec<(Method, Motion)> = Vec::new();
             for &method in &options.methods {
                 let convert = ConvertOptions {
                     method,
@@ -601,7 +605,6 @@ fn evaluate_set(
                     time_scale: out.duration() / source.motion.duration(),
                     timings: restyled.timings,
                 });
-                outputs.push((method, restyled.motion));
             }
             // The source left unchanged, scored against the style clip.
             source_rows.push(PairResult {
@@ -618,26 +621,21 @@ fn evaluate_set(
                 time_scale: 1.0,
                 timings: StageTimings::default(),
             });
-            if let Some(dir) = &options.filmstrips {
-                let wanted = filmstrips.len() < options.filmstrip_count
-                    && source.labels.style != style.labels.style
-                    && source.labels.style == "normal";
-                if wanted {
-                    std::fs::create_dir_all(dir).map_err(|e| mocap_core::Error::io(dir, e))?;
-                    let path = dir.join(format!("{}__{}.png", source.name, style.name));
-                    let mut rows = vec![
-                        FilmstripRow::new(format!("source: {}", source.name), &source.motion),
-                        FilmstripRow::new(format!("style: {}", style.name), &style.motion),
-                    ];
-                    for (m, motion) in &outputs {
-                        rows.push(FilmstripRow::new(format!("output: {}", m.name()), motion));
-                    }
-                    draw_filmstrip(&path, &rows, rig, 8)?;
-                    filmstrips.push(path);
-                }
-            }
         }
     }
+    let filmstrips = match &options.filmstrips {
+        Some(dir) => draw_filmstrips(
+            model,
+            dir,
+            &sources,
+            &style_clips,
+            &prepared,
+            &prepare_times,
+            &periods,
+            options,
+        )?,
+        None => Vec::new(),
+    };
     if pairs.is_empty() {
         return Err(invalid(format!(
             "set `{set}`: no (source, style clip) pair among the held-out clips; check the \
@@ -732,7 +730,7 @@ fn evaluate_set(
         contents,
         classifier_clips: classifier_clips.len(),
         test_clips: test_clips.len(),
-        classifier_style_accuracy: style_hits as f64 / test_clips.len() as f64,
+        classifier_style_accuracy: style_hits as f64 / style_tests.max(1) as f64,
         classifier_content_accuracy: content_hits as f64 / test_clips.len() as f64,
         skipped_clips,
         reference,
@@ -740,6 +738,73 @@ fn evaluate_set(
         pairs,
         filmstrips,
     })
+}
+
+/// Filmstrips of the pairs of different styles whose gait periods differ
+/// most (where the timing change shows), one row per method.
+#[allow(clippy::too_many_arguments)]
+fn draw_filmstrips(
+    model: &StyleModel,
+    dir: &Path,
+    sources: &[&Clip],
+    style_clips: &[&Clip],
+    prepared: &[StyleClip],
+    prepare_times: &[StageTimings],
+    periods: &BTreeMap<String, Option<f64>>,
+    options: &EvalOptions,
+) -> Result<Vec<PathBuf>> {
+    let mut candidates: Vec<(f64, usize, usize)> = Vec::new();
+    for (i, source) in sources.iter().enumerate() {
+        for (k, style) in style_clips.iter().enumerate() {
+            if source.labels.style == style.labels.style {
+                continue;
+            }
+            if let (Some(a), Some(b)) = (periods[&source.name], periods[&style.name]) {
+                candidates.push(((a - b).abs(), i, k));
+            }
+        }
+    }
+    candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut paths = Vec::new();
+    let mut used_sources = Vec::new();
+    for &(_, i, k) in &candidates {
+        if paths.len() >= options.filmstrip_count {
+            break;
+        }
+        // Different sources, for variety.
+        if used_sources.contains(&i) {
+            continue;
+        }
+        used_sources.push(i);
+        let (source, style) = (sources[i], style_clips[k]);
+        let mut outputs = Vec::new();
+        for &method in &options.methods {
+            let convert = ConvertOptions {
+                method,
+                ..options.convert
+            };
+            let r = restyle(
+                model,
+                &source.motion,
+                &[(&prepared[k], 1.0)],
+                &convert,
+                prepare_times[k],
+            )?;
+            outputs.push((method, r.motion));
+        }
+        std::fs::create_dir_all(dir).map_err(|e| mocap_core::Error::io(dir, e))?;
+        let path = dir.join(format!("{}__{}.png", source.name, style.name));
+        let mut rows = vec![
+            FilmstripRow::new(format!("source: {}", source.name), &source.motion),
+            FilmstripRow::new(format!("style: {}", style.name), &style.motion),
+        ];
+        for (m, motion) in &outputs {
+            rows.push(FilmstripRow::new(format!("output: {}", m.name()), motion));
+        }
+        draw_filmstrip(&path, &rows, &model.description.rig, 8)?;
+        paths.push(path);
+    }
+    Ok(paths)
 }
 
 impl EvalReport {
@@ -750,7 +815,7 @@ impl EvalReport {
             s.push_str(&format!(
                 "### {}\n\n{} styles (chance {:.1}%), {} contents; classifiers trained on {} clips, \
                  {} held-out test clips; classifier accuracy on the real held-out clips: style \
-                 {:.1}%, content {:.1}%.\n\n",
+                 {:.1}% (clips of the contents the style classifier trained on), content {:.1}%.\n\n",
                 set.set,
                 set.styles.len(),
                 100.0 * set.style_chance,

@@ -78,8 +78,8 @@ fn side_view(motion: &Motion, rig: &RigLayout) -> Vec<Vec<(f32, f32)>> {
 }
 
 /// Draws `rows` × `columns` stick figures to a PNG at `path` (written
-/// atomically). Column `k` shows each row's frame at fraction `k / (columns
-/// - 1)` of its own duration.
+/// atomically). Column `k` shows every row at the same time, `k / (columns
+/// - 1)` of the shortest row's duration, so a slower pace shows.
 pub fn draw_filmstrip(
     path: &Path,
     rows: &[FilmstripRow],
@@ -97,13 +97,26 @@ pub fn draw_filmstrip(
     let views: Vec<Vec<Vec<(f32, f32)>>> = rows.iter().map(|r| side_view(r.motion, rig)).collect();
     // One scale for every cell: the tallest figure fits.
     let (mut lo, mut hi, mut reach) = (f32::MAX, f32::MIN, 0.0f32);
-    for v in views.iter().flatten().flatten() {
-        lo = lo.min(v.1);
-        hi = hi.max(v.1);
-        reach = reach.max(v.0.abs());
+    // Only the joints drawn (the pelvis and below): a static world root
+    // far behind the walker must not shrink the figures.
+    let drawn: Vec<usize> = std::iter::once(rig.pelvis)
+        .chain(rig.joints.iter().copied())
+        .collect();
+    for frame in views.iter().flatten() {
+        for &j in &drawn {
+            let v = frame[j];
+            lo = lo.min(v.1);
+            hi = hi.max(v.1);
+            reach = reach.max(v.0.abs());
+        }
     }
+    lo = lo.min(0.0);
     let span = (hi - lo).max(2.0 * reach).max(1e-3) * 1.1;
     let scale = (CELL as f32 - 10.0) / span;
+    let shortest = rows
+        .iter()
+        .map(|r| (r.motion.frame_count() - 1) as f64 * r.motion.frame_time())
+        .fold(f64::INFINITY, f64::min);
     let mut buffer = vec![255u8; (width * height * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
@@ -131,11 +144,13 @@ pub fn draw_filmstrip(
             .map_err(|x| e(&x))?;
             let frames = view.len();
             for k in 0..columns {
-                let f = if columns == 1 {
-                    0
+                // The same moment (seconds) in every row, so paces compare.
+                let t = if columns == 1 {
+                    0.0
                 } else {
-                    k * (frames - 1) / (columns - 1)
+                    k as f64 * shortest / (columns - 1) as f64
                 };
+                let f = ((t * row.motion.fps()).round() as usize).min(frames - 1);
                 let cx = (k as u32 * CELL + CELL / 2) as f32;
                 let base = (top + LABEL + CELL - 5) as f32;
                 let to_px = |p: (f32, f32)| {

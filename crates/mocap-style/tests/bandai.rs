@@ -111,10 +111,20 @@ fn same_style_transfer_keeps_the_feet_planted() {
     let mut t = StageTimings::default();
     let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
     let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
-    let out = restyle(&model, &source, &[(&clip, 1.0)], &ConvertOptions::default(), t).unwrap();
+    let out = restyle(
+        &model,
+        &source,
+        &[(&clip, 1.0)],
+        &ConvertOptions::default(),
+        t,
+    )
+    .unwrap();
     let (skate_out, skate_source) = (foot_skating(&out.motion, &rig), foot_skating(&source, &rig));
     eprintln!("foot skating {skate_out} vs source {skate_source}");
-    assert!(skate_out < 2.0 * skate_source, "foot skating {skate_out} vs source {skate_source}");
+    assert!(
+        skate_out < 2.0 * skate_source,
+        "foot skating {skate_out} vs source {skate_source}"
+    );
 }
 
 #[test]
