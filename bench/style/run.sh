@@ -26,7 +26,8 @@ if [[ "${1:-}" == "--train" ]]; then
   "$BIN/train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
     -o models/style-default.safetensors "$DATA/dataset-1" "$DATA/dataset-2" > "$OUT/train.json"
   cp models/style-default.png bench/style/loss.png
-  rm -f models/style-default.png
+  # The loss plot goes to bench/style; the resumable state is not shipped.
+  rm -rf models/style-default.png models/style-default.state
 fi
 
 "$BIN/eval" --sources walk,walk-turn-left,walk-turn-right --styles walk \
