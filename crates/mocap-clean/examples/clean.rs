@@ -9,36 +9,6 @@ use std::path::PathBuf;
 use mocap_clean::filters::Filter;
 use mocap_clean::infer::{clean_file, CleanOptions, Method};
 
-fn parse_filter(text: &str) -> Result<Filter, String> {
-    let parts: Vec<&str> = text.split(':').collect();
-    let num = |k: usize| -> Result<f32, String> {
-        parts
-            .get(k)
-            .ok_or(format!("{text}: missing setting {k}"))?
-            .parse::<f32>()
-            .map_err(|e| e.to_string())
-    };
-    Ok(match parts[0] {
-        "butterworth" => Filter::Butterworth {
-            order: num(1)? as usize,
-            cutoff_hz: num(2)?,
-        },
-        "savitzky-golay" => Filter::SavitzkyGolay {
-            window: num(1)? as usize,
-            polyorder: num(2)? as usize,
-        },
-        "median" => Filter::Median {
-            window: num(1)? as usize,
-        },
-        "one-euro" => Filter::OneEuro {
-            min_cutoff_hz: num(1)?,
-            beta: num(2)?,
-            d_cutoff_hz: num(3)?,
-        },
-        other => return Err(format!("unknown filter {other}")),
-    })
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 2 {
@@ -61,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok_or(format!("{} needs a value", args[i]))?;
         match args[i].as_str() {
             "--model" => options.method = Method::Model(PathBuf::from(value)),
-            "--filter" => options.method = Method::Filter(parse_filter(value)?),
+            "--filter" => options.method = Method::Filter(value.parse::<Filter>()?),
             "--device" => options.device = value.parse()?,
             "--hop" => options.hop = Some(value.parse()?),
             other => return Err(format!("unknown option {other}").into()),

@@ -168,6 +168,55 @@ impl Filter {
     pub const FAMILIES: [&'static str; 4] = ["butterworth", "savitzky-golay", "median", "one-euro"];
 }
 
+impl std::str::FromStr for Filter {
+    type Err = CleanError;
+
+    /// Parses `butterworth:ORDER:CUTOFF_HZ`, `savitzky-golay:WINDOW:POLYORDER`,
+    /// `median:WINDOW` or `one-euro:MIN_CUTOFF_HZ:BETA:D_CUTOFF_HZ`.
+    fn from_str(text: &str) -> Result<Filter> {
+        let parts: Vec<&str> = text.split(':').collect();
+        let bad = |m: String| CleanError::Invalid(format!("filter `{text}`: {m}"));
+        let num = |k: usize| -> Result<f32> {
+            parts
+                .get(k)
+                .ok_or_else(|| bad(format!("missing setting {k}")))?
+                .parse::<f32>()
+                .map_err(|e| bad(format!("setting {k}: {e}")))
+        };
+        let count = |n: usize| {
+            if parts.len() == n + 1 {
+                Ok(())
+            } else {
+                Err(bad(format!("expected {n} settings after the name")))
+            }
+        };
+        let filter = match parts[0] {
+            "butterworth" => {
+                count(2)?;
+                Filter::Butterworth { order: num(1)? as usize, cutoff_hz: num(2)? }
+            }
+            "savitzky-golay" => {
+                count(2)?;
+                Filter::SavitzkyGolay { window: num(1)? as usize, polyorder: num(2)? as usize }
+            }
+            "median" => {
+                count(1)?;
+                Filter::Median { window: num(1)? as usize }
+            }
+            "one-euro" => {
+                count(3)?;
+                Filter::OneEuro { min_cutoff_hz: num(1)?, beta: num(2)?, d_cutoff_hz: num(3)? }
+            }
+            other => {
+                return Err(bad(format!(
+                    "unknown filter `{other}`: expected butterworth, savitzky-golay, median or one-euro"
+                )))
+            }
+        };
+        Ok(filter)
+    }
+}
+
 /// Filters the joint rotations of `motion` (see the module docs).
 pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
     let fps = motion.fps() as f32;
@@ -372,6 +421,24 @@ mod tests {
         }
         Filter::Median { window: 9 }.apply_track(&mut track, 30.0);
         assert!(track.iter().all(|&v| v == 1.0));
+    }
+
+    #[test]
+    fn filters_parse_from_text() {
+        assert_eq!(
+            "butterworth:2:6".parse::<Filter>().unwrap(),
+            Filter::Butterworth {
+                order: 2,
+                cutoff_hz: 6.0
+            }
+        );
+        assert_eq!(
+            "median:9".parse::<Filter>().unwrap(),
+            Filter::Median { window: 9 }
+        );
+        assert!("median".parse::<Filter>().is_err());
+        assert!("kalman:1".parse::<Filter>().is_err());
+        assert!("one-euro:1:x:1".parse::<Filter>().is_err());
     }
 
     #[test]
