@@ -35,6 +35,9 @@ pub const DEFAULT_MODEL_PATH: &str = concat!(
     "/../../models/clean-default.safetensors"
 );
 
+/// The shipped default model's bytes, compiled in.
+static DEFAULT_MODEL: &[u8] = include_bytes!("../../../models/clean-default.safetensors");
+
 /// A trained denoiser ready to clean takes.
 pub struct CleanModel {
     pub description: ModelDescription,
@@ -60,19 +63,19 @@ impl CleanModel {
         Self::from_bytes(bytes, path, device)
     }
 
-    /// The shipped default model (`models/clean-default.safetensors`), or
-    /// the file named by the `MOCAP_CLEAN_MODEL` environment variable.
+    /// The shipped default model, or the file named by the
+    /// `MOCAP_CLEAN_MODEL` environment variable. The default model
+    /// (`models/clean-default.safetensors`, about 1 MB) is compiled into the
+    /// binary, so it works wherever the binary is installed.
     pub fn load_default(device: DeviceChoice) -> Result<CleanModel> {
-        let path = std::env::var_os("MOCAP_CLEAN_MODEL")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL_PATH));
-        if !path.is_file() {
-            return Err(CleanError::Invalid(format!(
-                "{}: the default model is missing; pass a model with --model or use a classical filter",
-                path.display()
-            )));
+        if let Some(path) = std::env::var_os("MOCAP_CLEAN_MODEL") {
+            return Self::load(Path::new(&path), device);
         }
-        Self::load(&path, device)
+        Self::from_bytes(
+            DEFAULT_MODEL.to_vec(),
+            Path::new(DEFAULT_MODEL_PATH),
+            device,
+        )
     }
 
     /// Loads checkpoint bytes; `origin` names them in errors.
