@@ -1,5 +1,6 @@
 //! The `mocap` command as a user runs it: outputs, exit codes and messages.
 
+use mocap_testdata::shared_data;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -23,18 +24,6 @@ fn sample() -> String {
         .join("samples/dataset-1_walk_normal_001.bvh")
         .display()
         .to_string()
-}
-
-fn shared_data() -> Option<PathBuf> {
-    let dir = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("../shared/data"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: {} not found, skipping", dir.display());
-        None
-    }
 }
 
 fn stderr(out: &Output) -> String {

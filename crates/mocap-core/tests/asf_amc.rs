@@ -7,6 +7,7 @@
 //! see the module documentation of `mocap_core::io::asf_amc`). The converted
 //! `Motion` must give the same positions through `forward_kinematics`.
 
+use mocap_testdata::shared_data;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -19,22 +20,6 @@ use mocap_core::{forward_kinematics, Error, Motion};
 
 // ---------------------------------------------------------------------------
 // Data
-
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {} (set MOCAP_SHARED_DATA); skipping",
-            dir.display()
-        );
-        None
-    }
-}
 
 fn hdm05() -> Option<(PathBuf, PathBuf)> {
     let dir = shared_data()?.join("hdm05-sample");

@@ -4,6 +4,7 @@
 use mocap_core::bodymap::*;
 use mocap_core::rotation::Vec3;
 use mocap_core::{Error, Joint, Skeleton};
+use mocap_testdata::shared_data;
 
 /// A skeleton from `(name, parent name)` pairs in parent-before-child order,
 /// with unit offsets (only the names matter here).
@@ -477,24 +478,7 @@ fn parts_mirror_and_keys_round_trip() {
 use mocap_core::io::asf_amc::read_asf_amc;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::{forward_kinematics, Motion};
-use std::path::{Path, PathBuf};
-
-/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
-            dir.display()
-        );
-        None
-    }
-}
+use std::path::PathBuf;
 
 /// Checks, on the first frame of a take that starts standing, that the
 /// detected parts are at the anatomical points they stand for.

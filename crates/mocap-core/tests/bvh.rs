@@ -1,6 +1,7 @@
 //! BVH reader and writer on real files (the Bandai Namco takes and the
 //! parser cases from other exporters) and on small hand-made fixtures.
 
+use mocap_testdata::{bvh_files, shared_data};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -8,37 +9,10 @@ use mocap_core::io::bvh::{read_bvh, read_bvh_from, write_bvh, write_bvh_to};
 use mocap_core::rotation::Vec3;
 use mocap_core::{Channel, Joint, Motion, Skeleton};
 
-/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
-            dir.display()
-        );
-        None
-    }
-}
-
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/bvh")
         .join(name)
-}
-
-fn bvh_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
-        .collect();
-    files.sort();
-    files
 }
 
 /// What the file says, found without the reader: the number after

@@ -1,29 +1,12 @@
 //! Metrics: hand-computed values on tiny inputs, exact invariants on real
 //! Bandai takes, and errors on inputs of different shapes.
 
-use std::path::{Path, PathBuf};
+use mocap_testdata::shared_data;
 
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::*;
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, Channel, GlobalPoses, Joint, Motion, Skeleton};
-
-/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
-            dir.display()
-        );
-        None
-    }
-}
 
 /// Poses from positions given frame after frame (identity rotations).
 fn poses(joint_count: usize, positions: Vec<Vec3>) -> GlobalPoses {

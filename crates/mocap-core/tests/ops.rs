@@ -2,6 +2,7 @@
 //! skeletons, and geometric invariants on real takes (Bandai Namco, the
 //! CMU-style and Mixamo parser cases, HDM05 ASF/AMC).
 
+use mocap_testdata::shared_data;
 use std::path::{Path, PathBuf};
 
 use mocap_core::bodymap::{mirror_pairs, BodyMap};
@@ -10,23 +11,6 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::ops::*;
 use mocap_core::rotation::{angle_between, Axis, Quat, Vec3};
 use mocap_core::{forward_kinematics, Channel, GlobalPoses, Joint, Motion, Skeleton};
-
-/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
-            dir.display()
-        );
-        None
-    }
-}
 
 /// Every `step`-th Bandai file of a dataset folder, sorted by name.
 fn bandai_files(data: &Path, dataset: &str, step: usize) -> Vec<PathBuf> {

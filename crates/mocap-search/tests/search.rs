@@ -5,6 +5,7 @@
 //! `MOCAP_SHARED_DATA` points; without it each test prints a note and
 //! returns.
 
+use mocap_testdata::shared_data;
 use std::path::{Path, PathBuf};
 
 use mocap_core::rotation::{Quat, Vec3};
@@ -17,22 +18,6 @@ use mocap_search::{
     build_index, evaluate, load_clips, load_motion, motion_files, EvalConfig, Index, IndexConfig,
     LabelRule, NamePattern, SearchError,
 };
-
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    if dir.join("bandai").is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA",
-            dir.display()
-        );
-        None
-    }
-}
 
 /// Every `step`-th dataset-1 clip of the given contents.
 fn bandai_clips(data: &Path, contents: &[&str], step: usize) -> Vec<PathBuf> {

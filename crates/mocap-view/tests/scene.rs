@@ -1,6 +1,7 @@
 //! The viewer's data: positions from mocap_core's FK in metres, topology,
 //! end sites, confidence, JSON; on the bundled sample and real takes.
 
+use mocap_testdata::shared_data;
 use std::path::{Path, PathBuf};
 
 use mocap_core::io::asf_amc::read_asf_amc;
@@ -16,23 +17,6 @@ fn workspace() -> PathBuf {
 
 fn sample() -> PathBuf {
     workspace().join("samples/dataset-1_walk_normal_001.bvh")
-}
-
-/// `<workspace root>/../shared/data`, or `MOCAP_SHARED_DATA`.
-fn shared_data() -> Option<PathBuf> {
-    let dir = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => workspace().join("../shared/data"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: shared data not found at {}; set MOCAP_SHARED_DATA. Skipping.",
-            dir.display()
-        );
-        None
-    }
 }
 
 /// Height of the shown points of one frame.
