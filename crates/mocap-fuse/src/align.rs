@@ -892,9 +892,11 @@ pub fn calibrate_from_body(
             (Some(f), Some(m)) if m.1 > f.1 => (m, msrc.len()),
             (Some(f), _) => (f, src.len()),
             (None, Some(m)) => (m, msrc.len()),
-            (None, None) => return Err(Error::Invalid(format!(
+            (None, None) => {
+                return Err(Error::Invalid(format!(
                 "sensor {sensor}: no consistent transform found (the joints seen are degenerate)"
-            ))),
+            )))
+            }
         };
         let ((transform, inliers, rms), pairs) = best;
         calibration.set(SensorPose {
