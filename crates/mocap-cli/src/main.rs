@@ -32,6 +32,8 @@ enum Command {
     Convert(commands::convert::Args),
     /// Global joint positions of every frame, as CSV or JSON.
     Positions(commands::positions::Args),
+    /// Multi-sensor capture: simulate, calibrate, fuse (offline or as a UDP server), write BVH, evaluate.
+    Fuse(commands::fuse::Args),
     /// Motion retrieval by example: index a labelled library, query it, evaluate.
     Search(commands::search::Args),
     /// Play motions in a local web viewer (127.0.0.1).
@@ -47,6 +49,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),
         Command::Positions(args) => commands::positions::run(args, &options),
+        Command::Fuse(args) => commands::fuse::run(args, &options),
         Command::Search(args) => commands::search::run(args, &options),
         Command::View(args) => commands::view::view(args, &options),
         Command::Render(args) => commands::view::render(args, &options),

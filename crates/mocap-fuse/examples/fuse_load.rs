@@ -74,6 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             wait: 0.1,
             sensor_timeout: 0.5,
             duration: Some(Duration::from_secs_f64(seconds + 1.5)),
+            idle_exit: None,
         };
         let server = serve(options, &mut sink, std::future::pending(), Some(tx));
         let clients = async {

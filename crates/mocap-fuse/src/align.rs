@@ -863,23 +863,32 @@ pub fn calibrate_from_body(
         let period = 1.0 / 30.0;
         let mut paired_frames = 0;
         let mut settled: Vec<(Joints, Joints)> = Vec::new();
+        let mut as_labelled: Vec<(Joints, Joints)> = Vec::new();
         for (f, own) in frames.iter().zip(settle_labels(frames, WINDOW, MARGIN)) {
-            if sample_stream(ref_frames, f.timestamp, period).is_none() {
+            let Some(reference_joints) = sample_stream(ref_frames, f.timestamp, period) else {
                 continue;
-            }
+            };
             paired_frames += 1;
+            as_labelled.push((f.joints, reference_joints));
             let (Some(a), Some(b)) = (own, sample_stream(&settled_reference, f.timestamp, period))
             else {
                 continue;
             };
             settled.push((a, b));
         }
+        // Too few frames where both could tell left from right (a person
+        // standing still, seen from the side with one foot hidden): fall back
+        // to the labels as reported, and let the two global hypotheses (as
+        // labelled, all mirrored) decide below.
+        let settled_frames = settled.len();
+        if joint_pairs(&settled, &|_| false).0.len() < 30 {
+            settled = as_labelled;
+        }
         let (src, dst) = joint_pairs(&settled, &|_| false);
         if src.len() < 30 {
             return Err(Error::Invalid(format!(
                 "sensor {sensor} and reference sensor {reference} share only {} tracked joint \
-                 observations in frames where both could tell the person's left from right (by the \
-                 feet and knees): calibration from the body needs both to see the whole person at \
+                 observations: calibration from the body needs both to see the whole person at \
                  the same time ({paired_frames} frames at the same instants)",
                 src.len()
             )));
@@ -911,7 +920,7 @@ pub fn calibrate_from_body(
             pairs,
             inliers,
             rms,
-            settled_frames: settled.len(),
+            settled_frames,
             paired_frames,
             mirrored_inliers,
         });

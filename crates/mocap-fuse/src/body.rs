@@ -249,6 +249,126 @@ impl BodyModel {
     }
 }
 
+impl BodyModel {
+    /// Reads a body file (the JSON that [`BodyModel::write`] writes).
+    pub fn read(path: &std::path::Path) -> mocap_core::Result<BodyModel> {
+        let text = std::fs::read_to_string(path).map_err(|e| mocap_core::Error::io(path, e))?;
+        let body: BodyModel = serde_json::from_str(&text).map_err(|e| {
+            mocap_core::Error::Parse(mocap_core::ParseError {
+                location: mocap_core::error::Location {
+                    path: path.to_path_buf(),
+                    line: e.line(),
+                    column: e.column(),
+                },
+                message: format!(
+                    "expected a body file (bone_lengths: 25 numbers or null, ranges: {} objects {{min, max}} or null): {e}",
+                    ANGLES.len()
+                ),
+            })
+        })?;
+        if body.ranges.len() != ANGLES.len() {
+            return Err(mocap_core::Error::Invalid(format!(
+                "{}: expected {} joint ranges, found {}",
+                path.display(),
+                ANGLES.len(),
+                body.ranges.len()
+            )));
+        }
+        let bad_length = body
+            .bone_lengths
+            .iter()
+            .flatten()
+            .any(|l| !(l.is_finite() && *l > 0.0));
+        let bad_range = body
+            .ranges
+            .iter()
+            .flatten()
+            .any(|r| !(r.min.is_finite() && r.max.is_finite() && r.min <= r.max));
+        if bad_length || bad_range {
+            return Err(mocap_core::Error::Invalid(format!(
+                "{}: bone lengths must be positive and ranges must have min <= max",
+                path.display()
+            )));
+        }
+        Ok(body)
+    }
+
+    /// Writes the body as JSON, atomically.
+    pub fn write(&self, path: &std::path::Path) -> mocap_core::Result<()> {
+        let text = serde_json::to_string_pretty(self).expect("a body model always serializes");
+        mocap_core::io::atomic::write_bytes_atomically(path, text.as_bytes())
+    }
+}
+
+/// Joint ranges from a skeleton's range-of-motion limits (ASF `limits`, kept
+/// by the ASF reader in [`mocap_core::Joint::limits`]), as an alternative to
+/// measuring them.
+///
+/// The limits bound the Euler angles of one joint's rotation; our ranges
+/// bound angles between bones measured from joint positions ([`ANGLES`]).
+/// So each angle's range is found by sampling: the joint at the angle's
+/// vertex (the knee for the knee angle...) is turned through a grid of 9
+/// values per limited degree of freedom, the rest of the skeleton held in its
+/// rest pose, and the angle measured on the Kinect joints of each sample
+/// ([`crate::sim::truth_from_motion`]); the range is the smallest and largest
+/// angle seen. Angles whose vertex joint has no rotation limits stay `None`.
+/// Only the vertex joint turns, so an angle that two joints make together
+/// (clavicle and shoulder) gets the range of the one at the vertex.
+pub fn ranges_from_limits(
+    skeleton: &mocap_core::Skeleton,
+) -> mocap_core::Result<Vec<Option<AngleRange>>> {
+    use mocap_core::bodymap::{BodyMap, KINECT_V2_BODY_PARTS};
+    use mocap_core::rotation::Quat;
+    const STEPS: usize = 9;
+    let map = BodyMap::detect(skeleton)?;
+    let mut ranges = vec![None; ANGLES.len()];
+    for (a, def) in ANGLES.iter().enumerate() {
+        let Some(joint) = KINECT_V2_BODY_PARTS[def.vertex].and_then(|part| map.joint(part)) else {
+            continue;
+        };
+        let Some(limits) = &skeleton.joint(joint).limits else {
+            continue;
+        };
+        let dofs: Vec<_> = limits
+            .dofs
+            .iter()
+            .filter(|d| d.channel.is_rotation())
+            .collect();
+        if dofs.is_empty() {
+            continue;
+        }
+        let samples = STEPS.pow(dofs.len() as u32);
+        let mut motion = mocap_core::Motion::rest(skeleton.clone(), 1.0 / 30.0, samples)?;
+        for i in 0..samples {
+            // Sample i's angle of each dof: digit k of i in base STEPS.
+            let mut rest = i;
+            let mut local = Quat::IDENTITY;
+            for d in &dofs {
+                let step = rest % STEPS;
+                rest /= STEPS;
+                let degrees = d.min + (d.max - d.min) * step as f32 / (STEPS - 1) as f32;
+                // Intrinsic, in the order listed (as BVH channels).
+                local *= d.channel.axis().rotation(degrees.to_radians());
+            }
+            let q = limits.axis_frame * local * limits.axis_frame.inverse();
+            motion.set_local_rotation(i, joint, q);
+        }
+        let truth = crate::sim::truth_from_motion(&motion, Some(1.0))?;
+        let angles: Vec<f32> = truth
+            .frames
+            .iter()
+            .filter_map(|p| joint_angle(def, p))
+            .collect();
+        if let (Some(min), Some(max)) = (
+            angles.iter().copied().reduce(f32::min),
+            angles.iter().copied().reduce(f32::max),
+        ) {
+            ranges[a] = Some(AngleRange { min, max });
+        }
+    }
+    Ok(ranges)
+}
+
 /// The `q`-quantile of `samples` (sorted in place; nearest rank).
 pub fn percentile(samples: &mut [f32], q: f32) -> f32 {
     samples.sort_by(f32::total_cmp);
@@ -290,6 +410,56 @@ pub(crate) mod tests {
         p[THUMB_LEFT] = p[WRIST_LEFT] + Vec3::new(0.0, -0.05, 0.04);
         p[THUMB_RIGHT] = p[WRIST_RIGHT] + Vec3::new(0.0, -0.05, 0.04);
         p
+    }
+
+    #[test]
+    fn asf_limits_give_knee_and_elbow_ranges_that_flex_one_way() {
+        let root = std::env::var_os("MOCAP_SHARED_DATA")
+            .map(std::path::PathBuf::from)
+            .unwrap_or_else(|| {
+                std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+            });
+        let asf = root.join("hdm05-sample/HDM_bd.asf");
+        if !asf.exists() {
+            eprintln!("note: {} not found; skipping", asf.display());
+            return;
+        }
+        let skeleton = mocap_core::io::asf_amc::read_asf(&asf)
+            .unwrap()
+            .to_skeleton(mocap_core::io::asf_amc::LengthUnit::Centimetres)
+            .unwrap();
+        let ranges = ranges_from_limits(&skeleton).unwrap();
+        for (a, def) in ANGLES.iter().enumerate() {
+            eprintln!(
+                "{}: {:?}",
+                crate::kinect::JOINT_NAMES[def.vertex],
+                ranges[a]
+            );
+        }
+        // HDM05's knees: rx in (-10, 170) about an axis across the leg; the
+        // knee angle is signed, so the range reaches far one way (flexion)
+        // and only a little the other (hyperextension): the measured sign
+        // convention must match the one of a walking person.
+        let knee = ranges[0].unwrap();
+        let (small, large) = if knee.max.abs() > knee.min.abs() {
+            (knee.min, knee.max)
+        } else {
+            (knee.max, knee.min)
+        };
+        assert!(large.abs() > 150.0 && small.abs() < 20.0, "{knee:?}");
+        let other = ranges[1].unwrap();
+        assert!((other.min - knee.min).abs() < 1.0 && (other.max - knee.max).abs() < 1.0);
+        // Elbow (unsigned): straight to well bent.
+        let elbow = ranges[6].unwrap();
+        assert!(elbow.min < 15.0 && elbow.max > 120.0, "{elbow:?}");
+        // A walking knee measured from positions flexes the same way.
+        let walking = {
+            let mut p = tests::standing_pose();
+            let shank = p[ANKLE_LEFT].distance(p[KNEE_LEFT]);
+            p[ANKLE_LEFT] = p[KNEE_LEFT] + Vec3::new(0.0, -0.8, -0.6).normalize() * shank;
+            joint_angle(&ANGLES[0], &p).unwrap()
+        };
+        assert_eq!(walking.signum(), large.signum(), "{walking} vs {knee:?}");
     }
 
     #[test]

@@ -6,8 +6,9 @@
 //! - **the skeleton**: the Kinect v2 joints (same names, so
 //!   [`mocap_core::bodymap::BodyMap::detect`] finds the body parts), in
 //!   parent-before-child order, rooted at `SpineBase`. Each bone's length is
-//!   the person's measured length ([`BodyModel::bone_lengths`]; the median
-//!   length in the fused frames where the body model has none). The rest pose
+//!   measured: by default the median over the fused frames, or the person's
+//!   body model ([`BoneLengthSource`]); left and right sides get their mean
+//!   length. The rest pose
 //!   is a T-pose facing +z with y up; joints that branch off a chain (the hips
 //!   off the pelvis, the shoulders off the upper spine, the thumbs off the
 //!   wrists) keep their median place relative to their parent, measured in
@@ -23,11 +24,12 @@
 //!   local rotations are `G_parent^-1 G`. Joints at the end of a chain (head,
 //!   feet, hand tips, thumbs) carry no rotation of their own.
 //!
-//! Forward kinematics of the result puts every chain joint exactly along the
-//! fused bone direction; positions then differ from the fused ones only
-//! because bone lengths are fixed (the fused skeleton's bones stretch from
-//! frame to frame) and because the branching joints keep one place relative
-//! to their parent. [`fit_error`] measures that difference.
+//! Each bone is aimed from where forward kinematics puts its joint at the
+//! fused child joint, so a joint's position differs from the fused one only
+//! by its own bone's length difference (the fused skeleton's bones stretch
+//! from frame to frame) and, for the branching joints, by their fixed place
+//! relative to their parent; differences do not add up along the chain.
+//! [`fit_error`] measures them.
 
 use mocap_core::rotation::{Mat3, Quat, Vec3};
 use mocap_core::{Channel, Error, Joint, Motion, Result, Skeleton};
@@ -54,6 +56,24 @@ impl Default for BvhOptions {
             fps: 30.0,
         }
     }
+}
+
+/// Where the BVH skeleton's bone lengths come from. Either way, left and
+/// right bones get the mean of the two sides (people are close to
+/// symmetric; one sensor's per-joint biases are not).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BoneLengthSource {
+    /// The median length of each bone over the fused frames of this take:
+    /// measured from all sensors at once, so single sensors' joint biases
+    /// average out. On simulated Bandai takes this BVH is as close to the
+    /// truth as the fused joints are; with [`BoneLengthSource::Body`] it is
+    /// several millimetres further (`bench/results/fuse.md`).
+    Fused,
+    /// The person's body model ([`BodyModel::bone_lengths`], measured
+    /// beforehand from single sensors' Tracked joints); the fused median
+    /// where it has none.
+    Body,
 }
 
 /// How the twist of a joint's frame is chosen.
@@ -201,64 +221,76 @@ fn rest_frame(joint: usize) -> Mat3 {
 /// Per-frame global rotations of the 25 joints (Kinect order) so that each
 /// chain joint's bone points at its fused child. `bend` carries each limb's
 /// twist direction from frame to frame.
+///
+/// With `offsets` (the skeleton's rest offsets, metres), each bone is aimed
+/// from where forward kinematics puts its joint, not from the fused joint:
+/// a bone whose length differs from the fused one then moves only its own
+/// end, instead of shifting everything below it (errors do not add up along
+/// the chain).
 fn global_rotations(
     p: &[Vec3; JOINT_COUNT],
     previous: Option<&[Quat; JOINT_COUNT]>,
     bend: &mut [Option<Vec3>; JOINT_COUNT],
+    offsets: Option<&[Vec3; JOINT_COUNT]>,
 ) -> [Quat; JOINT_COUNT] {
     let mut frames: [Option<Mat3>; JOINT_COUNT] = [None; JOINT_COUNT];
+    let mut global = [Quat::IDENTITY; JOINT_COUNT];
+    // Where each joint is: forward kinematics so far, or the fused joints.
+    let mut at = *p;
     // This frame's twist of each limb, by the limb's root joint: the upper
     // and lower bone share it, so the middle joint turns about one axis.
     let mut limb: [Option<Vec3>; JOINT_COUNT] = [None; JOINT_COUNT];
-    for c in &CHAINS {
-        let bone = p[c.child] - p[c.joint];
-        let twist = match c.twist {
-            Twist::Line(a, b) => p[b] - p[a],
-            Twist::TwoLines((a, b), (d, e)) => {
-                (p[b] - p[a]).normalize_or_zero() + (p[e] - p[d]).normalize_or_zero()
-            }
-            Twist::Bend(r, m, e) => *limb[r].get_or_insert_with(|| {
-                // The bend normal grows with the bend (|upper x lower| is the
-                // sine of the angle); the previous frame's direction, given a
-                // small weight, takes over when the limb is nearly straight.
-                let upper = (p[m] - p[r]).normalize_or_zero();
-                let lower = (p[e] - p[m]).normalize_or_zero();
-                let normal = upper.cross(lower);
-                // First frame: a twist from the body, right for a limb
-                // hanging down and for the T-pose alike (legs: the hip line
-                // to the left; left arm: right and down; right arm: right
-                // and up, as the rest pose's bend normals).
-                let carried = bend[r].unwrap_or_else(|| {
-                    let left = (p[HIP_LEFT] - p[HIP_RIGHT]).normalize_or(X);
-                    let up = (p[SPINE_SHOULDER] - p[SPINE_BASE]).normalize_or(Y);
-                    if c.rest_twist == X {
-                        left
-                    } else if c.rest_twist == NY {
-                        -left - up
-                    } else {
-                        -left + up
-                    }
-                });
-                let t = normal + 0.25 * carried;
-                bend[r] = t.try_normalize().or(bend[r]);
-                t
-            }),
-        };
-        frames[c.joint] = frame_of(bone, twist);
-    }
-    for &(ankle, foot, knee) in &ANKLES {
-        let twist = frames[knee].map_or(X, |f| f.y_axis);
-        frames[ankle] = frame_of(p[foot] - p[ankle], twist);
-    }
-    let mut global = [Quat::IDENTITY; JOINT_COUNT];
     for &n in &TOPOLOGICAL_ORDER {
+        if let (Some(offsets), Some(parent)) = (offsets, PARENTS[n]) {
+            at[n] = at[parent] + global[parent] * offsets[n];
+        }
+        if let Some(c) = chain_of(n) {
+            let bone = p[c.child] - at[n];
+            let twist = match c.twist {
+                Twist::Line(a, b) => p[b] - p[a],
+                Twist::TwoLines((a, b), (d, e)) => {
+                    (p[b] - p[a]).normalize_or_zero() + (p[e] - p[d]).normalize_or_zero()
+                }
+                Twist::Bend(r, m, e) => *limb[r].get_or_insert_with(|| {
+                    // The bend normal grows with the bend (|upper x lower| is
+                    // the sine of the angle); the previous frame's direction,
+                    // given a small weight, takes over when the limb is nearly
+                    // straight.
+                    let upper = (p[m] - p[r]).normalize_or_zero();
+                    let lower = (p[e] - p[m]).normalize_or_zero();
+                    let normal = upper.cross(lower);
+                    // First frame: a twist from the body, right for a limb
+                    // hanging down and for the T-pose alike (legs: the hip
+                    // line to the left; left arm: right and down; right arm:
+                    // right and up, as the rest pose's bend normals).
+                    let carried = bend[r].unwrap_or_else(|| {
+                        let left = (p[HIP_LEFT] - p[HIP_RIGHT]).normalize_or(X);
+                        let up = (p[SPINE_SHOULDER] - p[SPINE_BASE]).normalize_or(Y);
+                        if c.rest_twist == X {
+                            left
+                        } else if c.rest_twist == NY {
+                            -left - up
+                        } else {
+                            -left + up
+                        }
+                    });
+                    let t = normal + 0.25 * carried;
+                    bend[r] = t.try_normalize().or(bend[r]);
+                    t
+                }),
+            };
+            frames[n] = frame_of(bone, twist);
+        } else if let Some(&(_, foot, knee)) = ANKLES.iter().find(|a| a.0 == n) {
+            let twist = frames[knee].map_or(X, |f| f.y_axis);
+            frames[n] = frame_of(p[foot] - at[n], twist);
+        }
         global[n] = match frames[n] {
             Some(f) => Quat::from_mat3(&(f * rest_frame(n).transpose())).normalize(),
             None => match (chain_child(n), previous) {
                 // A degenerate bone this frame: keep the last rotation.
                 (Some(_), Some(prev)) => prev[n],
                 // Ends of chains turn with their parent.
-                _ => PARENTS[n].map_or(Quat::IDENTITY, |p| global[p]),
+                _ => PARENTS[n].map_or(Quat::IDENTITY, |q| global[q]),
             },
         };
     }
@@ -273,13 +305,16 @@ pub struct FittedSkeleton {
     pub joint_index: [usize; JOINT_COUNT],
     /// Bone lengths used (metres), Kinect order (0 for the root).
     pub bone_lengths: [f32; JOINT_COUNT],
+    /// Rest offsets (metres), Kinect order.
+    pub offsets: [Vec3; JOINT_COUNT],
 }
 
-/// Builds the skeleton (see the module documentation) from the person's
-/// measured bone lengths and the fused poses (metres).
+/// Builds the skeleton (see the module documentation) from the fused poses
+/// (metres), with bone lengths from `source`.
 pub fn fit_skeleton(
     poses: &[[Vec3; JOINT_COUNT]],
     body: &BodyModel,
+    source: BoneLengthSource,
     units_per_metre: f32,
 ) -> Result<FittedSkeleton> {
     if poses.is_empty() {
@@ -290,14 +325,16 @@ pub fn fit_skeleton(
     let mut lengths = [0.0f32; JOINT_COUNT];
     for n in 0..JOINT_COUNT {
         let Some(p) = PARENTS[n] else { continue };
-        lengths[n] = match body.bone_lengths[n] {
-            Some(l) if l.is_finite() && l > 0.0 => l,
+        lengths[n] = match (source, body.bone_lengths[n]) {
+            (BoneLengthSource::Body, Some(l)) if l.is_finite() && l > 0.0 => l,
             _ => {
                 let mut seen: Vec<f32> = poses.iter().map(|q| q[n].distance(q[p])).collect();
                 percentile(&mut seen, 0.5)
             }
         };
     }
+    let lengths: [f32; JOINT_COUNT] =
+        std::array::from_fn(|n| 0.5 * (lengths[n] + lengths[crate::kinect::MIRROR[n]]));
     // Rest offsets, in metres: along the rest bone direction of the parent's
     // chain, or (branching joints) the median direction in the parent's
     // frame, taken over the fused poses.
@@ -306,7 +343,7 @@ pub fn fit_skeleton(
     let globals: Vec<[Quat; JOINT_COUNT]> = {
         let mut out: Vec<[Quat; JOINT_COUNT]> = Vec::with_capacity(poses.len());
         for p in poses {
-            let g = global_rotations(p, out.last(), &mut bend);
+            let g = global_rotations(p, out.last(), &mut bend, None);
             out.push(g);
         }
         out
@@ -371,6 +408,7 @@ pub fn fit_skeleton(
         skeleton: Skeleton::new(joints)?,
         joint_index,
         bone_lengths: lengths,
+        offsets,
     })
 }
 
@@ -396,11 +434,22 @@ pub fn regular_poses(frames: &[FusedFrame], fps: f64) -> Vec<[Vec3; JOINT_COUNT]
     out
 }
 
-/// The fused frames as a BVH motion (see the module documentation).
+/// The fused frames as a BVH motion (see the module documentation), bone
+/// lengths from the fused frames ([`BoneLengthSource::Fused`]).
 pub fn fused_to_motion(
     frames: &[FusedFrame],
     body: &BodyModel,
     options: &BvhOptions,
+) -> Result<Motion> {
+    fused_to_motion_with(frames, body, options, BoneLengthSource::Fused)
+}
+
+/// [`fused_to_motion`] with bone lengths from `lengths`.
+pub fn fused_to_motion_with(
+    frames: &[FusedFrame],
+    body: &BodyModel,
+    options: &BvhOptions,
+    lengths: BoneLengthSource,
 ) -> Result<Motion> {
     if !(options.fps.is_finite() && options.fps > 0.0) {
         return Err(Error::Invalid(format!(
@@ -415,22 +464,33 @@ pub fn fused_to_motion(
         )));
     }
     let poses = regular_poses(frames, options.fps);
-    poses_to_motion(&poses, body, options)
+    poses_to_motion_with(&poses, body, options, lengths)
 }
 
 /// Joint positions (metres, Kinect order, one array per frame at
-/// `options.fps`) as a BVH motion on a fitted skeleton.
+/// `options.fps`) as a BVH motion on a fitted skeleton, bone lengths from
+/// the poses ([`BoneLengthSource::Fused`]).
 pub fn poses_to_motion(
     poses: &[[Vec3; JOINT_COUNT]],
     body: &BodyModel,
     options: &BvhOptions,
 ) -> Result<Motion> {
-    let fitted = fit_skeleton(poses, body, options.units_per_metre)?;
+    poses_to_motion_with(poses, body, options, BoneLengthSource::Fused)
+}
+
+/// [`poses_to_motion`] with bone lengths from `lengths`.
+pub fn poses_to_motion_with(
+    poses: &[[Vec3; JOINT_COUNT]],
+    body: &BodyModel,
+    options: &BvhOptions,
+    lengths: BoneLengthSource,
+) -> Result<Motion> {
+    let fitted = fit_skeleton(poses, body, lengths, options.units_per_metre)?;
     let mut motion = Motion::rest(fitted.skeleton.clone(), 1.0 / options.fps, poses.len())?;
     let mut bend = [None; JOINT_COUNT];
     let mut previous: Option<[Quat; JOINT_COUNT]> = None;
     for (f, p) in poses.iter().enumerate() {
-        let global = global_rotations(p, previous.as_ref(), &mut bend);
+        let global = global_rotations(p, previous.as_ref(), &mut bend, Some(&fitted.offsets));
         for n in 0..JOINT_COUNT {
             let local = match PARENTS[n] {
                 Some(parent) => global[parent].inverse() * global[n],
@@ -593,7 +653,8 @@ mod tests {
             p[FOOT_LEFT] += d * 0.05;
         }
         let options = BvhOptions::default();
-        let motion = poses_to_motion(&stretched, &body, &options).unwrap();
+        let motion =
+            poses_to_motion_with(&stretched, &body, &options, BoneLengthSource::Body).unwrap();
         let fk = mocap_core::forward_kinematics(&motion);
         let sk = motion.skeleton();
         let (knee, ankle) = (sk.find("KneeLeft").unwrap(), sk.find("AnkleLeft").unwrap());

@@ -52,6 +52,10 @@ pub struct EvalOptions {
     pub simulation: SimulationOptions,
     /// Length units per metre of the BVH files; guessed when `None`.
     pub units_per_metre: Option<f32>,
+    /// Joint ranges from ASF limits ([`crate::body::ranges_from_limits`]):
+    /// when given, two more methods use them instead of the measured ranges.
+    #[serde(skip)]
+    pub limit_ranges: Option<Vec<Option<crate::body::AngleRange>>>,
 }
 
 impl Default for EvalOptions {
@@ -63,6 +67,7 @@ impl Default for EvalOptions {
             calibration: CalibrationSource::Truth,
             simulation: SimulationOptions::default(),
             units_per_metre: None,
+            limit_ranges: None,
         }
     }
 }
@@ -94,6 +99,19 @@ pub struct EvalReport {
     pub state_shares: [f64; 3],
     /// Share of sensor frames with left and right swapped (seen from behind).
     pub swapped_share: f64,
+    /// With calibration from the body: how far the sensors' poses are from
+    /// the truth, over all calibrated (non-reference) sensors of all runs.
+    pub calibration_error: Option<CalibrationError>,
+}
+
+/// How far calibrated sensor poses are from the true ones.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+pub struct CalibrationError {
+    pub sensors: usize,
+    pub mean_degrees: f64,
+    pub max_degrees: f64,
+    pub mean_metres: f64,
+    pub max_metres: f64,
 }
 
 /// The methods compared, in table order. `None` is the best single sensor.
@@ -156,8 +174,29 @@ pub fn methods() -> Vec<(String, Option<FusionOptions>)> {
             }),
         ),
         (
-            "best: + robust reweighting (c = 25 cm)".into(),
+            "previous best: + robust reweighting (c = 25 cm), swap by the feet".into(),
+            Some(FusionOptions {
+                knee_cue: false,
+                ..FusionOptions::best()
+            }),
+        ),
+        (
+            "best: + swap repair by feet and knees".into(),
             Some(FusionOptions::best()),
+        ),
+        (
+            "best + Savitzky-Golay smoothing (offline, 7 frames)".into(),
+            Some(FusionOptions::preset("best-smooth").expect("a preset")),
+        ),
+        (
+            "best + depth weighting, Inferred 0.07, learnt reliability".into(),
+            Some({
+                let mut o = FusionOptions::best();
+                o.confidence.state_weights.inferred = 0.07;
+                o.depth_reference = Some(3.0);
+                o.adaptive_rate = Some(0.02);
+                o
+            }),
         ),
         (
             "best + One Euro filter".into(),
@@ -206,8 +245,29 @@ struct Sums {
 
 /// Runs the evaluation.
 pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
+    evaluate_with(options, &mut |_, _| {})
+}
+
+/// Runs the evaluation, calling `progress(clips done, clips)` after each clip.
+pub fn evaluate_with(
+    options: &EvalOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<EvalReport> {
     let files = collect_bvh_files(&options.inputs)?;
-    let methods = methods();
+    let mut methods = methods();
+    // Methods with the ASF ranges: marked by this prefix, run with a body
+    // whose ranges are replaced.
+    const ASF: &str = "ASF ranges: ";
+    if options.limit_ranges.is_some() {
+        let mut report_swap = FusionOptions::report();
+        report_swap.swap_repair = true;
+        methods.push((
+            format!("{ASF}report (all terms) + swap repair"),
+            Some(report_swap),
+        ));
+        methods.push((format!("{ASF}best"), Some(FusionOptions::best())));
+    }
+    let mut calibration_error = CalibrationError::default();
     let mut sums = vec![vec![Sums::default(); methods.len()]; options.sensor_counts.len()];
     let mut truth_jitter = (0.0, 0usize);
     let mut states = [0f64; 3];
@@ -280,6 +340,24 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                         let mut c = found.calibration.clone();
                         for s in c.sensors.iter_mut() {
                             s.transform = world_from_reference.then_after(&s.transform);
+                            if s.id != found.reference {
+                                let truth = truth_calibration
+                                    .get(s.id)
+                                    .expect("the simulator calibrates every sensor");
+                                let degrees =
+                                    s.transform
+                                        .rotation
+                                        .angle_between(truth.rotation)
+                                        .to_degrees() as f64;
+                                let metres =
+                                    (s.transform.translation - truth.translation).length() as f64;
+                                let e = &mut calibration_error;
+                                e.sensors += 1;
+                                e.mean_degrees += degrees;
+                                e.mean_metres += metres;
+                                e.max_degrees = e.max_degrees.max(degrees);
+                                e.max_metres = e.max_metres.max(metres);
+                            }
                         }
                         c
                     }
@@ -290,9 +368,17 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                     truth_jitter.0 += jitter(&poses);
                     truth_jitter.1 += 1;
                 }
-                for (mi, (_, method)) in methods.iter().enumerate() {
+                let asf_body = options.limit_ranges.as_ref().map(|ranges| BodyModel {
+                    ranges: ranges.clone(),
+                    ..body.clone()
+                });
+                for (mi, (name, method)) in methods.iter().enumerate() {
+                    let body_here = match (&asf_body, name.starts_with(ASF)) {
+                        (Some(b), true) => b,
+                        _ => &body,
+                    };
                     let m = match method {
-                        Some(o) => run_method(&streams, &calibration, &truth, &body, *o),
+                        Some(o) => run_method(&streams, &calibration, &truth, body_here, *o),
                         None => best_single(&streams, &calibration, &truth, &body),
                     };
                     let Some((mpjpe, bone, jit)) = m else {
@@ -306,6 +392,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 }
             }
         }
+        progress(clips.len(), files.len());
     }
     let total_states: f64 = states.iter().sum();
     let mut results = Vec::new();
@@ -331,6 +418,14 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         truth_jitter_mm: truth_jitter.0 / truth_jitter.1.max(1) as f64,
         state_shares: states.map(|s| s / total_states.max(1.0)),
         swapped_share: swapped as f64 / frames_seen.max(1) as f64,
+        calibration_error: (calibration_error.sensors > 0).then(|| {
+            let n = calibration_error.sensors as f64;
+            CalibrationError {
+                mean_degrees: calibration_error.mean_degrees / n,
+                mean_metres: calibration_error.mean_metres / n,
+                ..calibration_error
+            }
+        }),
     })
 }
 
@@ -451,6 +546,13 @@ pub fn report_markdown(report: &EvalReport, command: &str) -> String {
         100.0 * report.swapped_share,
         report.truth_jitter_mm,
     );
+    if let Some(e) = report.calibration_error {
+        s += &format!(
+            "Calibration from the body vs the true sensor poses ({} sensors): rotation {:.2} degrees mean, {:.2} max; \
+             position {:.3} m mean, {:.3} max.\n\n",
+            e.sensors, e.mean_degrees, e.max_degrees, e.mean_metres, e.max_metres
+        );
+    }
     s += "| sensors | method | MPJPE (mm) | hip-knee/knee-ankle length error (mm) | jitter (mm/frame^2) | runs |\n";
     s += "| --- | --- | --- | --- | --- | --- |\n";
     for r in &report.results {
@@ -493,4 +595,225 @@ pub fn write_report(path: &Path, report: &EvalReport, command: &str) -> Result<(
         path,
         report_markdown(report, command).as_bytes(),
     )
+}
+
+/// The bones whose length consistency is reported: the torso, arms and
+/// legs, without the hand tips, thumbs and feet, whose Kinect estimates are
+/// too short and noisy to say much.
+pub const CONSISTENCY_BONES: [usize; 16] = [
+    SPINE_MID,
+    SPINE_SHOULDER,
+    NECK,
+    HEAD,
+    SHOULDER_LEFT,
+    ELBOW_LEFT,
+    WRIST_LEFT,
+    SHOULDER_RIGHT,
+    ELBOW_RIGHT,
+    WRIST_RIGHT,
+    HIP_LEFT,
+    KNEE_LEFT,
+    ANKLE_LEFT,
+    HIP_RIGHT,
+    KNEE_RIGHT,
+    ANKLE_RIGHT,
+];
+
+/// Bone-length consistency of one skeleton stream: a real bone keeps its
+/// length, so how much the lengths vary over time measures the error without
+/// ground truth.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ConsistencyRow {
+    /// `sensor K` (one sensor alone, in its own camera space) or the fusion
+    /// method.
+    pub source: String,
+    /// Frames with a skeleton.
+    pub frames: usize,
+    /// Mean over [`CONSISTENCY_BONES`] of the standard deviation of the
+    /// bone's length over the frames (mm).
+    pub bone_std_mm: f64,
+    /// The same as a share of the bone's mean length (%).
+    pub bone_cv_percent: f64,
+    /// Mean `|l - l_body|` over the same bones and frames, `l_body` the
+    /// length measured from all sensors' Tracked joints (mm).
+    pub bone_error_mm: f64,
+    /// Mean norm of the second difference of joint positions (mm/frame^2).
+    pub jitter_mm: f64,
+}
+
+/// The consistency evaluation of one take seen by several sensors.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ConsistencyReport {
+    pub take: String,
+    pub sensors: Vec<u16>,
+    /// Calibration from the body, per sensor.
+    pub calibration: Vec<crate::align::BodySensorReport>,
+    pub rows: Vec<ConsistencyRow>,
+}
+
+fn consistency_row(
+    source: String,
+    poses: &[[Vec3; JOINT_COUNT]],
+    seen: &dyn Fn(usize, usize) -> bool,
+    body: &BodyModel,
+) -> ConsistencyRow {
+    let (mut std_sum, mut cv_sum, mut bones) = (0.0, 0.0, 0usize);
+    let (mut err_sum, mut err_count) = (0.0, 0usize);
+    for &n in &CONSISTENCY_BONES {
+        let parent = crate::kinect::PARENTS[n].expect("every listed bone has a parent");
+        let lengths: Vec<f64> = poses
+            .iter()
+            .enumerate()
+            .filter(|(f, _)| seen(*f, n) && seen(*f, parent))
+            .map(|(_, p)| p[n].distance(p[parent]) as f64)
+            .collect();
+        if lengths.len() < 2 {
+            continue;
+        }
+        let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+        let var = lengths.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lengths.len() as f64;
+        std_sum += var.sqrt();
+        cv_sum += var.sqrt() / mean.max(1e-6);
+        bones += 1;
+        if let Some(l) = body.bone_lengths[n] {
+            err_sum += lengths.iter().map(|x| (x - l as f64).abs()).sum::<f64>();
+            err_count += lengths.len();
+        }
+    }
+    ConsistencyRow {
+        source,
+        frames: poses.len(),
+        bone_std_mm: 1000.0 * std_sum / bones.max(1) as f64,
+        bone_cv_percent: 100.0 * cv_sum / bones.max(1) as f64,
+        bone_error_mm: 1000.0 * err_sum / err_count.max(1) as f64,
+        jitter_mm: jitter(poses),
+    }
+}
+
+/// Evaluates fusion on a real multi-sensor capture without ground truth:
+/// the sensors are calibrated from the body ([`crate::align::calibrate_from_body`]),
+/// fused with each method, and the bone-length consistency of each single
+/// sensor and each fused result is compared ([`ConsistencyRow`]). The person's
+/// bone lengths come from all sensors' Tracked joints.
+pub fn evaluate_consistency(
+    take: &str,
+    frames: Vec<crate::recording::SensorFrame>,
+    methods: &[(String, FusionOptions)],
+    fps: f64,
+) -> Result<ConsistencyReport> {
+    let streams = SensorStreams::new(frames);
+    if streams.streams.len() < 2 {
+        return Err(Error::Invalid(format!(
+            "{take}: fusion needs at least two sensors, found {}",
+            streams.streams.len()
+        )));
+    }
+    let body = BodyModel::measure(
+        streams
+            .streams
+            .values()
+            .flat_map(|s| s.iter().map(|f| &f.joints)),
+        MeasureOptions::default(),
+    );
+    let found = crate::align::calibrate_from_body(&streams, &Default::default())?;
+    let mut rows = Vec::new();
+    for (&sensor, frames) in &streams.streams {
+        let poses: Vec<[Vec3; JOINT_COUNT]> = frames
+            .iter()
+            .map(|f| f.joints.map(|j| j.position))
+            .collect();
+        let seen = |f: usize, n: usize| {
+            frames[f].joints[n].state != crate::kinect::TrackingState::NotTracked
+        };
+        rows.push(consistency_row(
+            format!("sensor {sensor}"),
+            &poses,
+            &seen,
+            &body,
+        ));
+    }
+    for (name, options) in methods {
+        let mut fuser = Fuser::new(*options, body.clone());
+        let fused = fuse_streams(&streams, &found.calibration, &mut fuser, fps, None);
+        let poses: Vec<[Vec3; JOINT_COUNT]> = fused.iter().map(|f| f.joints).collect();
+        rows.push(consistency_row(name.clone(), &poses, &|_, _| true, &body));
+    }
+    Ok(ConsistencyReport {
+        take: take.to_string(),
+        sensors: streams.streams.keys().copied().collect(),
+        calibration: found.sensors,
+        rows,
+    })
+}
+
+/// Groups recordings into takes: NTU files whose names differ only in the
+/// camera (`S001C001P001R001A001` and `S001C002P001R001A001`) are one take
+/// seen by several sensors; a `.jsonl` recording is a take of its own (it
+/// may hold several sensors).
+pub fn group_takes(paths: &[PathBuf]) -> Vec<(String, Vec<PathBuf>)> {
+    let mut takes: Vec<(String, Vec<PathBuf>)> = Vec::new();
+    for p in paths {
+        let stem = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let is_ntu = p
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("skeleton"));
+        let key = match (is_ntu, stem.find('C')) {
+            (true, Some(at)) => {
+                let digits = stem[at + 1..]
+                    .chars()
+                    .take_while(|c| c.is_ascii_digit())
+                    .count();
+                format!("{}C*{}", &stem[..at], &stem[at + 1 + digits..])
+            }
+            _ => p.display().to_string(),
+        };
+        match takes.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, files)) => files.push(p.clone()),
+            None => takes.push((key, vec![p.clone()])),
+        }
+    }
+    takes
+}
+
+/// A consistency report as a Markdown table.
+pub fn consistency_markdown(reports: &[ConsistencyReport], command: &str) -> String {
+    let mut s = format!(
+        "Command: `{command}`\n\nNo ground truth: sensors calibrated from the body; bone-length consistency over the take \
+         (mean over {} bones of the standard deviation of each bone's length), its share of the mean length, the mean \
+         difference to the person's lengths measured from all sensors' Tracked joints, and jitter.\n",
+        CONSISTENCY_BONES.len()
+    );
+    for r in reports {
+        s += &format!(
+            "\n### {}\n\nSensors {:?}; calibration from the body: ",
+            r.take, r.sensors
+        );
+        for c in &r.calibration {
+            s += &format!(
+                "sensor {} {} inliers of {} pairs (RMS {:.1} mm; mirrored hypothesis {} inliers); ",
+                c.sensor,
+                c.inliers,
+                c.pairs,
+                c.rms * 1000.0,
+                c.mirrored_inliers
+            );
+        }
+        s += "\n\n| source | frames | bone length std (mm) | std / length (%) | length error (mm) | jitter (mm/frame^2) |\n";
+        s += "| --- | --- | --- | --- | --- | --- |\n";
+        for row in &r.rows {
+            s += &format!(
+                "| {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |\n",
+                row.source,
+                row.frames,
+                row.bone_std_mm,
+                row.bone_cv_percent,
+                row.bone_error_mm,
+                row.jitter_mm
+            );
+        }
+    }
+    s
 }

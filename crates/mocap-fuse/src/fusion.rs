@@ -57,6 +57,28 @@ pub struct FusionOptions {
     pub robust_scale: Option<f32>,
     /// One Euro filtering of the fused joints; `None` for none.
     pub smoothing: Option<OneEuroParams>,
+    /// Depth at which a Tracked joint's error is twice that of a joint right
+    /// in front of the sensor (m): weights are multiplied by
+    /// `1 / (1 + (d / d0)^2)^2`, the inverse variance of an error growing
+    /// with the square of the depth `d` (time-of-flight depth noise).
+    /// `None`: no depth weighting.
+    #[serde(default)]
+    pub depth_reference: Option<f32>,
+    /// Swap repair also reads bent knees as a label-free cue to facing
+    /// ([`crate::align::label_free_forward`]), not only the feet.
+    #[serde(default)]
+    pub knee_cue: bool,
+    /// Learn each sensor's reliability: per sensor, joint and tracking
+    /// state, a running mean (this rate per frame) of the squared distance
+    /// between the sensor's joint and the fused joint of the other sensors;
+    /// weights are divided by it. `None`: off.
+    #[serde(default)]
+    pub adaptive_rate: Option<f32>,
+    /// Offline only ([`crate::offline::fuse_streams`]): Savitzky-Golay
+    /// smoothing (quadratic, this many frames on either side) of the fused
+    /// joints, which removes jitter without the lag of a causal filter.
+    #[serde(default)]
+    pub centered_smoothing: Option<usize>,
 }
 
 impl FusionOptions {
@@ -71,6 +93,10 @@ impl FusionOptions {
             swap_repair: false,
             robust_scale: None,
             smoothing: None,
+            depth_reference: None,
+            knee_cue: false,
+            adaptive_rate: None,
+            centered_smoothing: None,
         }
     }
 
@@ -93,10 +119,13 @@ impl FusionOptions {
     /// Our best version: state weights, a wider bone-length term applied to
     /// each joint alone (not propagated: the evaluation shows propagation
     /// turns ordinary noise into frame-to-frame weight swings), the
-    /// range-of-motion term, swap repair and robust reweighting of gross
+    /// range-of-motion term, swap repair reading the feet and the bent knees
+    /// (the largest gain: a sensor seeing the back with its labels left
+    /// swapped is the dominant error) and robust reweighting of gross
     /// outliers. No temporal filter: the One Euro filter lowers jitter but
     /// its lag raises the position error (see `bench/results/fuse.md`);
-    /// switch it on with `smoothing` when jitter matters more.
+    /// offline, `best-smooth` adds Savitzky-Golay smoothing, which has no
+    /// lag.
     pub fn best() -> FusionOptions {
         FusionOptions {
             confidence: ConfidenceModel {
@@ -107,6 +136,58 @@ impl FusionOptions {
             swap_repair: true,
             robust_scale: Some(0.25),
             smoothing: None,
+            depth_reference: None,
+            knee_cue: true,
+            adaptive_rate: None,
+            centered_smoothing: None,
+        }
+    }
+}
+
+/// The named fusion methods of `mocap fuse run|serve --method`.
+pub const METHOD_NAMES: [&str; 5] = ["best", "best-smooth", "report", "bone", "state"];
+
+impl FusionOptions {
+    /// The options of a named method: `best` ([`FusionOptions::best`]),
+    /// `best-smooth` (the same with Savitzky-Golay smoothing offline; a
+    /// server cannot look ahead and uses the One Euro filter instead, see
+    /// [`FusionOptions::online`]), `report` (the
+    /// report's method, all terms), `bone` (state weights and the bone-length
+    /// term) or `state` (tracking-state weights only).
+    pub fn preset(name: &str) -> mocap_core::Result<FusionOptions> {
+        Ok(match name {
+            "best" => FusionOptions::best(),
+            "best-smooth" => FusionOptions {
+                centered_smoothing: Some(3),
+                ..FusionOptions::best()
+            },
+            "report" => FusionOptions::report(),
+            "bone" => FusionOptions::bone_length(crate::confidence::BoneLengthFunction::Gaussian {
+                sigma: 0.04,
+            }),
+            "state" => FusionOptions::state_only(),
+            other => {
+                return Err(mocap_core::Error::Invalid(format!(
+                    "unknown fusion method {other:?}; expected one of {}",
+                    METHOD_NAMES.join(", ")
+                )))
+            }
+        })
+    }
+}
+
+impl FusionOptions {
+    /// The options for fusing live (the server): smoothing that needs
+    /// future frames ([`FusionOptions::centered_smoothing`]) becomes the
+    /// causal One Euro filter.
+    pub fn online(self) -> FusionOptions {
+        match self.centered_smoothing {
+            Some(_) => FusionOptions {
+                centered_smoothing: None,
+                smoothing: self.smoothing.or(Some(OneEuroParams::default())),
+                ..self
+            },
+            None => self,
         }
     }
 }
@@ -115,6 +196,8 @@ impl FusionOptions {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensorView {
     pub sensor: u16,
+    /// Where the sensor is (world space), for depth weighting.
+    pub origin: Vec3,
     pub joints: [JointObservation; JOINT_COUNT],
 }
 
@@ -154,6 +237,8 @@ pub struct Fuser {
     body: BodyModel,
     previous: Option<(f64, [Vec3; JOINT_COUNT])>,
     filters: Option<[OneEuro; JOINT_COUNT]>,
+    /// Learnt squared error (m^2) per sensor, joint and tracking state.
+    reliability: std::collections::HashMap<(u16, usize, TrackingState), f32>,
 }
 
 /// The side-to-side direction of a skeleton as labelled: from the left
@@ -182,6 +267,7 @@ impl Fuser {
             body,
             previous: None,
             filters: None,
+            reliability: std::collections::HashMap::new(),
         }
     }
 
@@ -205,10 +291,28 @@ impl Fuser {
         } else {
             views.to_vec()
         };
-        let weights: Vec<[f32; JOINT_COUNT]> = views
+        let mut weights: Vec<[f32; JOINT_COUNT]> = views
             .iter()
             .map(|v| confidences(&self.options.confidence, &self.body, &v.joints))
             .collect();
+        if let Some(d0) = self.options.depth_reference {
+            for (v, w) in views.iter().zip(weights.iter_mut()) {
+                for (w, j) in w.iter_mut().zip(&v.joints) {
+                    let d = j.position.distance(v.origin) / d0;
+                    *w /= (1.0 + d * d).powi(2);
+                }
+            }
+        }
+        if self.options.adaptive_rate.is_some() {
+            for (v, w) in views.iter().zip(weights.iter_mut()) {
+                for (n, (w, j)) in w.iter_mut().zip(&v.joints).enumerate() {
+                    *w /= match self.reliability.get(&(v.sensor, n, j.state)) {
+                        Some(e2) => e2.max(1e-6),
+                        None => prior_squared_error(j.state),
+                    };
+                }
+            }
+        }
         let mut joints = [Vec3::ZERO; JOINT_COUNT];
         let mut confidence = [0.0f32; JOINT_COUNT];
         for n in 0..JOINT_COUNT {
@@ -235,6 +339,9 @@ impl Fuser {
                 joints[n] = sum / views.len() as f32;
             }
         }
+        if let Some(rate) = self.options.adaptive_rate {
+            self.learn_reliability(&views, &weights, rate);
+        }
         if let Some(params) = self.options.smoothing {
             joints = self.smooth(time, joints, params);
         }
@@ -248,13 +355,54 @@ impl Fuser {
         })
     }
 
+    /// Updates the running squared error of each sensor's joints against
+    /// the fused joint of the other sensors (leave one out, so that a sensor
+    /// does not vouch for itself).
+    fn learn_reliability(
+        &mut self,
+        views: &[SensorView],
+        weights: &[[f32; JOINT_COUNT]],
+        rate: f32,
+    ) {
+        for n in 0..JOINT_COUNT {
+            let total: f32 = weights.iter().map(|w| w[n]).sum();
+            let sum: Vec3 = views
+                .iter()
+                .zip(weights)
+                .map(|(v, w)| v.joints[n].position * w[n])
+                .sum();
+            for (v, w) in views.iter().zip(weights) {
+                let state = v.joints[n].state;
+                if state == TrackingState::NotTracked {
+                    continue;
+                }
+                let others = total - w[n];
+                if others <= total * 1e-3 {
+                    continue;
+                }
+                let reference = (sum - v.joints[n].position * w[n]) / others;
+                let e2 = v.joints[n].position.distance_squared(reference);
+                let entry = self
+                    .reliability
+                    .entry((v.sensor, n, state))
+                    .or_insert(prior_squared_error(state));
+                *entry += rate * (e2 - *entry);
+            }
+        }
+    }
+
     fn repair_swaps(&self, views: &[SensorView], swapped: &mut Vec<u16>) -> Vec<SensorView> {
         // Which way the person faces, from cues that do not depend on the
         // left/right labels: the feet point forward (ankle to foot, both
-        // feet, every sensor that sees them), plus the previous fused
-        // skeleton's facing for continuity when the feet say little.
+        // feet, every sensor that sees them) and, with `knee_cue`, bent
+        // knees stick out forward; plus the previous fused skeleton's facing
+        // for continuity when the cues say little.
         let mut forward = Vec3::ZERO;
         for v in views {
+            if self.options.knee_cue {
+                forward += crate::align::label_free_forward(&v.joints).normalize_or_zero();
+                continue;
+            }
             for (ankle, foot) in [(ANKLE_LEFT, FOOT_LEFT), (ANKLE_RIGHT, FOOT_RIGHT)] {
                 let (a, f) = (v.joints[ankle], v.joints[foot]);
                 if a.state == TrackingState::Tracked && f.state == TrackingState::Tracked {
@@ -274,8 +422,8 @@ impl Fuser {
                 if labelled.dot(forward) < 0.0 {
                     swapped.push(v.sensor);
                     SensorView {
-                        sensor: v.sensor,
                         joints: swap_left_right(&v.joints),
+                        ..*v
                     }
                 } else {
                     *v
@@ -318,6 +466,17 @@ impl Fuser {
     }
 }
 
+/// The squared error (m^2) a joint of this state is assumed to have before
+/// any is learnt: a few centimetres when Tracked, about 15 cm when Inferred
+/// (Kinect v2 against marker-based capture, see [`crate::sim`]).
+fn prior_squared_error(state: TrackingState) -> f32 {
+    match state {
+        TrackingState::Tracked => 0.04 * 0.04,
+        TrackingState::Inferred => 0.15 * 0.15,
+        TrackingState::NotTracked => 0.5 * 0.5,
+    }
+}
+
 /// `sum_k C_kn g_k J_kn / sum_k C_kn g_k` for joint `n`, with `g` an extra
 /// per-observation factor (1 for the paper's mean).
 fn weighted_mean(
@@ -351,6 +510,7 @@ mod tests {
     fn view(sensor: u16, pose: [Vec3; JOINT_COUNT], state: TrackingState) -> SensorView {
         SensorView {
             sensor,
+            origin: Vec3::new(0.0, 1.0, 3.0),
             joints: pose.map(|position| JointObservation { position, state }),
         }
     }
@@ -410,6 +570,7 @@ mod tests {
             view(1, pose, TrackingState::Tracked),
             SensorView {
                 sensor: 2,
+                origin: Vec3::new(0.0, 1.0, -3.0),
                 joints: behind,
             },
         ];

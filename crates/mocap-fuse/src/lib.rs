@@ -38,6 +38,7 @@ pub mod fusion;
 pub mod kinect;
 pub mod net;
 pub mod offline;
+pub mod output;
 pub mod ply;
 pub mod recording;
 pub mod sim;

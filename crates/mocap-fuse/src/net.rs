@@ -79,6 +79,9 @@ pub struct ServeOptions {
     pub sensor_timeout: f64,
     /// Stop after this long (wall clock); `None`: until the shutdown signal.
     pub duration: Option<Duration>,
+    /// Stop when no datagram has come for this long after the first one
+    /// (a replay has ended); `None`: keep listening.
+    pub idle_exit: Option<Duration>,
 }
 
 /// What the server saw and did.
@@ -192,6 +195,7 @@ impl Timeline {
                 let joints = sample_stream(frames, t, self.period)?;
                 Some(SensorView {
                     sensor,
+                    origin: pose.translation,
                     joints: joints.map(|j| JointObservation {
                         position: pose.apply(j.position),
                         state: j.state,
@@ -327,7 +331,7 @@ pub async fn serve(
                 .map_err(|e| Error::Invalid(e.to_string()))?,
         );
     }
-    let mut fuser = Fuser::new(options.fusion, options.body.clone());
+    let mut fuser = Fuser::new(options.fusion.online(), options.body.clone());
     let mut timeline = Timeline::new(options.fps, options.wait, options.sensor_timeout);
     let mut report = ServeReport::default();
     let mut latencies: Vec<f64> = Vec::new();
@@ -336,50 +340,57 @@ pub async fn serve(
     let deadline = options.duration.map(|d| tokio::time::Instant::now() + d);
     tokio::pin!(shutdown);
     let mut tick = tokio::time::interval(Duration::from_millis(20));
+    let mut last_datagram: Option<Instant> = None;
     loop {
-        let stop = tokio::select! {
-            _ = &mut shutdown => true,
-            _ = async {
-                match deadline {
-                    Some(d) => tokio::time::sleep_until(d).await,
-                    None => std::future::pending().await,
-                }
-            } => true,
-            _ = tick.tick() => false,
-            received = socket.recv_from(&mut buf) => {
-                let arrival = Instant::now();
-                match received {
-                    Ok((len, from)) => {
-                        report.datagrams += 1;
-                        match decode_datagram(&buf[..len]) {
-                            Ok(frame) => {
-                                if options.calibration.get(frame.sensor).is_none() {
-                                    report.uncalibrated += 1;
-                                    if report.uncalibrated <= 5 {
-                                        eprintln!("fuse serve: datagram from {from}: sensor {} is not in the calibration; ignored", frame.sensor);
-                                    }
-                                } else {
-                                    sensors_seen.insert(frame.sensor);
-                                    match timeline.push(frame, arrival) {
-                                        Ok(()) => report.frames_accepted += 1,
-                                        Err("duplicate") => report.duplicates += 1,
-                                        Err(_) => report.late += 1,
+        let idle = match (options.idle_exit, last_datagram) {
+            (Some(limit), Some(last)) => last.elapsed() >= limit,
+            _ => false,
+        };
+        let stop = idle
+            || tokio::select! {
+                _ = &mut shutdown => true,
+                _ = async {
+                    match deadline {
+                        Some(d) => tokio::time::sleep_until(d).await,
+                        None => std::future::pending().await,
+                    }
+                } => true,
+                _ = tick.tick() => false,
+                received = socket.recv_from(&mut buf) => {
+                    let arrival = Instant::now();
+                    last_datagram = Some(arrival);
+                    match received {
+                        Ok((len, from)) => {
+                            report.datagrams += 1;
+                            match decode_datagram(&buf[..len]) {
+                                Ok(frame) => {
+                                    if options.calibration.get(frame.sensor).is_none() {
+                                        report.uncalibrated += 1;
+                                        if report.uncalibrated <= 5 {
+                                            eprintln!("fuse serve: datagram from {from}: sensor {} is not in the calibration; ignored", frame.sensor);
+                                        }
+                                    } else {
+                                        sensors_seen.insert(frame.sensor);
+                                        match timeline.push(frame, arrival) {
+                                            Ok(()) => report.frames_accepted += 1,
+                                            Err("duplicate") => report.duplicates += 1,
+                                            Err(_) => report.late += 1,
+                                        }
                                     }
                                 }
-                            }
-                            Err(why) => {
-                                report.malformed += 1;
-                                if report.malformed <= 5 {
-                                    eprintln!("fuse serve: malformed datagram from {from} ({len} bytes): {why}");
+                                Err(why) => {
+                                    report.malformed += 1;
+                                    if report.malformed <= 5 {
+                                        eprintln!("fuse serve: malformed datagram from {from} ({len} bytes): {why}");
+                                    }
                                 }
                             }
                         }
+                        Err(e) => eprintln!("fuse serve: receive error: {e}"),
                     }
-                    Err(e) => eprintln!("fuse serve: receive error: {e}"),
+                    false
                 }
-                false
-            }
-        };
+            };
         drain(
             &mut timeline,
             &mut fuser,
@@ -509,6 +520,33 @@ pub fn serve_blocking(options: ServeOptions, sink: &mut dyn FrameSink) -> Result
     ))
 }
 
+/// Like [`serve_blocking`], calling `on_listening` with the bound address
+/// once the socket is open (to print it when the port was 0).
+pub fn serve_blocking_with(
+    options: ServeOptions,
+    sink: &mut dyn FrameSink,
+    on_listening: impl FnOnce(SocketAddr),
+) -> Result<ServeReport> {
+    runtime()?.block_on(async {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        let server = serve(
+            options,
+            sink,
+            async {
+                let _ = tokio::signal::ctrl_c().await;
+            },
+            Some(tx),
+        );
+        let announce = async {
+            if let Ok(addr) = rx.await {
+                on_listening(addr);
+            }
+        };
+        let (report, ()) = tokio::join!(server, announce);
+        report
+    })
+}
+
 /// `mocap fuse send`.
 pub fn send_blocking(frames: &[SensorFrame], options: SendOptions) -> Result<SendReport> {
     runtime()?.block_on(send(frames, options))
@@ -575,7 +613,8 @@ mod tests {
                 fps: 30.0,
                 wait: 0.1,
                 sensor_timeout: 0.5,
-                duration: Some(Duration::from_millis(1500)),
+                duration: Some(Duration::from_millis(3000)),
+                idle_exit: Some(Duration::from_millis(400)),
             };
             let (tx, rx) = tokio::sync::oneshot::channel();
             let mut sink = MemorySink::default();

@@ -101,6 +101,7 @@ pub fn views_at(
             let joints = sample_stream(frames, t, period)?;
             Some(SensorView {
                 sensor,
+                origin: pose.translation,
                 joints: joints.map(|j| JointObservation {
                     position: pose.apply(j.position),
                     state: j.state,
@@ -151,7 +152,71 @@ pub fn fuse_streams(
             out.push(f);
         }
     }
+    if let Some(half) = fuser.options().centered_smoothing {
+        savitzky_golay(&mut out, half);
+    }
     out
+}
+
+/// Quadratic Savitzky-Golay smoothing of the joints over `2 half + 1`
+/// frames (Savitzky and Golay, Analytical Chemistry 1964): each value is
+/// replaced by the value at the centre of the least-squares parabola
+/// through its neighbours, so peaks of the motion are kept better than by a
+/// moving average. The weights are `(3(3m^2 + 3m - 1) - 15 i^2) / ((2m +
+/// 1)(4m^2 + 4m - 3))` for `i` in `-m..=m`. Frames nearer the ends than
+/// `half` are left as they are.
+pub fn savitzky_golay(frames: &mut [FusedFrame], half: usize) {
+    let m = half as i64;
+    if half == 0 || frames.len() < 2 * half + 1 {
+        return;
+    }
+    let denominator = ((2 * m + 1) * (4 * m * m + 4 * m - 3)) as f32;
+    let weights: Vec<f32> = (-m..=m)
+        .map(|i| (3 * (3 * m * m + 3 * m - 1) - 15 * i * i) as f32 / denominator)
+        .collect();
+    let original: Vec<[mocap_core::rotation::Vec3; JOINT_COUNT]> =
+        frames.iter().map(|f| f.joints).collect();
+    for c in half..frames.len() - half {
+        for (n, joint) in frames[c].joints.iter_mut().enumerate() {
+            *joint = weights
+                .iter()
+                .enumerate()
+                .map(|(k, w)| original[c + k - half][n] * *w)
+                .sum();
+        }
+    }
+}
+
+/// `mocap fuse run`: fuses recorded frames into `sink`. Every sensor must be
+/// in the calibration. Returns how many fused frames were written.
+pub fn fuse_recordings(
+    frames: Vec<SensorFrame>,
+    calibration: &Calibration,
+    fuser: &mut Fuser,
+    fps: f64,
+    sink: &mut dyn crate::net::FrameSink,
+) -> Result<usize> {
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(Error::Invalid(format!(
+            "the fused frame rate must be positive, got {fps}"
+        )));
+    }
+    let streams = SensorStreams::new(frames);
+    if streams.streams.is_empty() {
+        return Err(Error::Invalid(
+            "the recordings hold no sensor frames".into(),
+        ));
+    }
+    check_calibrated(&streams, calibration)?;
+    // Instants on multiples of the period, as the server fuses them, so that
+    // offline and live outputs (and ground truth) share their times.
+    let start = streams.span().map(|(first, _)| (first * fps).ceil() / fps);
+    let fused = fuse_streams(&streams, calibration, fuser, fps, start);
+    for f in &fused {
+        sink.write(f)?;
+    }
+    sink.finish()?;
+    Ok(fused.len())
 }
 
 #[cfg(test)]

@@ -710,6 +710,124 @@ pub fn sensor_point_cloud(
         .collect()
 }
 
+/// The files [`write_simulation`] wrote.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulationFiles {
+    /// One recording per sensor (`sensor-K.jsonl`).
+    pub recordings: Vec<std::path::PathBuf>,
+    /// The same as NTU `.skeleton` files, when asked for.
+    pub ntu: Vec<std::path::PathBuf>,
+    /// The true sensor poses (`truth.calib.toml`).
+    pub calibration: std::path::PathBuf,
+    /// The person measured from a second simulated capture (`body.json`).
+    pub body: std::path::PathBuf,
+    /// The ground-truth joints in the fused-frame JSON lines format
+    /// (`truth.jsonl`).
+    pub truth: std::path::PathBuf,
+    /// Each sensor's scan of the room in its camera space (`sensor-K.ply`).
+    pub scans: Vec<std::path::PathBuf>,
+    /// Floor marks picked in the scans of sensor 0 and sensor K
+    /// (`pairs-0-K.txt`), for `mocap fuse calibrate --points`.
+    pub pairs: Vec<std::path::PathBuf>,
+}
+
+/// Writes a simulation to the folder `dir` (created if needed): see
+/// [`SimulationFiles`]. The room scans sample [`room_points`] every 5 cm.
+/// The pairs files hold five marks on the floor around the capture area (as
+/// tape marks one would pick by hand in both scans), with 1 cm of picking
+/// error.
+pub fn write_simulation(
+    dir: &std::path::Path,
+    sim: &Simulation,
+    body: &crate::body::BodyModel,
+    seed: u64,
+    ntu: bool,
+) -> Result<SimulationFiles> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut files = SimulationFiles {
+        recordings: Vec::new(),
+        ntu: Vec::new(),
+        calibration: dir.join("truth.calib.toml"),
+        body: dir.join("body.json"),
+        truth: dir.join("truth.jsonl"),
+        scans: Vec::new(),
+        pairs: Vec::new(),
+    };
+    for s in &sim.sensors {
+        let path = dir.join(format!("sensor-{}.jsonl", s.id));
+        crate::recording::write_recording(&path, &s.frames)?;
+        files.recordings.push(path);
+        if ntu {
+            let path = dir.join(format!("S001C{:03}P001R001A001.skeleton", s.id));
+            crate::recording::write_ntu_skeleton(
+                &path,
+                &s.frames,
+                72057594037927936 + s.id as u64,
+            )?;
+            files.ntu.push(path);
+        }
+    }
+    sim.calibration().write(&files.calibration)?;
+    body.write(&files.body)?;
+    mocap_core::io::atomic::write_atomically(&files.truth, |w| {
+        for (i, joints) in sim.truth.frames.iter().enumerate() {
+            let frame = crate::fusion::FusedFrame {
+                time: i as f64 / sim.truth.fps,
+                joints: *joints,
+                confidence: [1.0; JOINT_COUNT],
+                sensors: Vec::new(),
+                swapped: Vec::new(),
+            };
+            writeln!(w, "{}", crate::net::fused_frame_json(&frame))?;
+        }
+        Ok(())
+    })?;
+    let model = SensorModel::default();
+    let room = room_points(0.05, seed);
+    for s in &sim.sensors {
+        let path = dir.join(format!("sensor-{}.ply", s.id));
+        let cloud = sensor_point_cloud(&room, &s.pose, &model, seed.wrapping_add(s.id as u64));
+        crate::ply::write_ply_points(
+            &path,
+            &cloud,
+            crate::ply::PlyEncoding::BinaryLittleEndian,
+            &format!(
+                "room scan of simulated sensor {}, camera space, metres",
+                s.id
+            ),
+        )?;
+        files.scans.push(path);
+    }
+    let marks = [
+        Vec3::ZERO,
+        Vec3::new(0.8, 0.0, 0.8),
+        Vec3::new(-0.8, 0.0, 0.8),
+        Vec3::new(0.8, 0.0, -0.8),
+        Vec3::new(-0.8, 0.0, -0.8),
+    ];
+    let mut rng = StdRng::seed_from_u64(seed ^ 0x7a11);
+    if let Some(first) = sim.sensors.first() {
+        for s in &sim.sensors[1..] {
+            let path = dir.join(format!("pairs-{}-{}.txt", first.id, s.id));
+            let mut text = format!(
+                "# floor marks picked in the scans of sensor {} (x y z) and sensor {} (x y z), metres, camera space\n",
+                first.id, s.id
+            );
+            for &m in &marks {
+                let a = first.pose.inverse().apply(m + gaussian3(&mut rng) * 0.01);
+                let b = s.pose.inverse().apply(m + gaussian3(&mut rng) * 0.01);
+                text += &format!(
+                    "{:.4} {:.4} {:.4} {:.4} {:.4} {:.4}\n",
+                    a.x, a.y, a.z, b.x, b.y, b.z
+                );
+            }
+            mocap_core::io::atomic::write_bytes_atomically(&path, text.as_bytes())?;
+            files.pairs.push(path);
+        }
+    }
+    Ok(files)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,470 @@
+//! `mocap fuse` as a user runs it: simulate a capture from the bundled
+//! sample take, calibrate, fuse to JSON lines and BVH, stream over loopback
+//! UDP, evaluate. Every network test uses 127.0.0.1 and is bounded in time.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn mocap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args(args)
+        .output()
+        .expect("the mocap binary runs")
+}
+
+fn sample() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../samples/dataset-1_walk_normal_001.bvh")
+        .display()
+        .to_string()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(out.status.success(), "{}", stderr(out));
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&out.stdout)))
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// A simulated 3-sensor capture of the sample take in a temporary folder.
+fn simulated(extra: &[&str]) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = dir.path().join("sim");
+    let mut args = vec![
+        "fuse",
+        "simulate",
+        &sample(),
+        "--sensors",
+        "3",
+        "--seed",
+        "2",
+        "--out",
+    ]
+    .into_iter()
+    .map(String::from)
+    .collect::<Vec<_>>();
+    args.push(s(&sim));
+    args.extend(extra.iter().map(|a| a.to_string()));
+    args.push("--json".into());
+    let out = mocap(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let report = json(&out);
+    assert_eq!(report["sensors"].as_array().unwrap().len(), 3);
+    (dir, sim)
+}
+
+fn recordings(sim: &Path) -> Vec<String> {
+    (0..3)
+        .map(|k| s(&sim.join(format!("sensor-{k}.jsonl"))))
+        .collect()
+}
+
+/// Mean distance (m) between the joints of two fused-frame JSON lines files
+/// at the same times (to 1 ms).
+fn mean_distance(a: &Path, b: &Path) -> f64 {
+    let read = |p: &Path| -> Vec<(f64, Vec<[f64; 3]>)> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let v: serde_json::Value = serde_json::from_str(l).unwrap();
+                let joints = v["joints"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|j| {
+                        let c: Vec<f64> = j
+                            .as_array()
+                            .unwrap()
+                            .iter()
+                            .map(|x| x.as_f64().unwrap())
+                            .collect();
+                        [c[0], c[1], c[2]]
+                    })
+                    .collect();
+                (v["t"].as_f64().unwrap(), joints)
+            })
+            .collect()
+    };
+    let (a, b) = (read(a), read(b));
+    let mut sum = 0.0;
+    let mut count = 0;
+    for (t, ja) in &a {
+        if let Some((_, jb)) = b.iter().find(|(u, _)| (u - t).abs() < 1e-3) {
+            for (p, q) in ja.iter().zip(jb) {
+                sum +=
+                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+                count += 1;
+            }
+        }
+    }
+    assert!(count > 1000, "too few common frames: {count}");
+    sum / count as f64
+}
+
+#[test]
+fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
+    let (dir, sim) = simulated(&[]);
+    let d = dir.path();
+    // Fused with the true calibration, compared with the ground truth.
+    let fused = d.join("fused.jsonl");
+    let bvh = d.join("fused.bvh");
+    let mut args = vec!["fuse".to_string(), "run".into()];
+    args.extend(recordings(&sim));
+    args.extend(
+        [
+            "--calib",
+            &s(&sim.join("truth.calib.toml")),
+            "--body",
+            &s(&sim.join("body.json")),
+            "--out",
+            &s(&fused),
+            "--out",
+            &s(&bvh),
+            "--json",
+        ]
+        .map(String::from),
+    );
+    let report = json(&mocap(&args.iter().map(String::as_str).collect::<Vec<_>>()));
+    assert!(report["fused_frames"].as_u64().unwrap() > 180, "{report}");
+    let error = mean_distance(&fused, &sim.join("truth.jsonl"));
+    eprintln!("fused vs ground truth: {:.1} mm", error * 1000.0);
+    assert!(error < 0.08, "{error} m");
+    // The BVH: Kinect joints, readable, and its forward kinematics close to
+    // the fused joints (what is left is the fused bones' stretch).
+    let outputs = report["outputs"].as_array().unwrap();
+    let bvh_report = outputs.iter().find(|o| o["format"] == "bvh").unwrap();
+    let fit = &bvh_report["fit_error"];
+    eprintln!("BVH vs fused joints: {fit}");
+    assert!(fit["body_mean_mm"].as_f64().unwrap() < 35.0, "{fit}");
+    let motion = mocap_core::io::bvh::read_bvh(&bvh).unwrap();
+    assert_eq!(motion.skeleton().joint_count(), 25);
+    assert_eq!(
+        motion.frame_count() as u64,
+        bvh_report["frames"].as_u64().unwrap()
+    );
+    // Its forward kinematics against the ground truth: as close as the fused
+    // joints are (fixed bone lengths do not cost accuracy).
+    let first_time = {
+        let line = std::fs::read_to_string(&fused).unwrap();
+        let v: serde_json::Value = serde_json::from_str(line.lines().next().unwrap()).unwrap();
+        v["t"].as_f64().unwrap()
+    };
+    let bvh_as_jsonl = d.join("bvh.jsonl");
+    let fk = mocap_core::forward_kinematics(&motion);
+    let names = [
+        "SpineBase",
+        "SpineMid",
+        "Neck",
+        "Head",
+        "ShoulderLeft",
+        "ElbowLeft",
+        "WristLeft",
+        "HandLeft",
+        "ShoulderRight",
+        "ElbowRight",
+        "WristRight",
+        "HandRight",
+        "HipLeft",
+        "KneeLeft",
+        "AnkleLeft",
+        "FootLeft",
+        "HipRight",
+        "KneeRight",
+        "AnkleRight",
+        "FootRight",
+        "SpineShoulder",
+        "HandTipLeft",
+        "ThumbLeft",
+        "HandTipRight",
+        "ThumbRight",
+    ];
+    let index: Vec<usize> = names
+        .iter()
+        .map(|n| motion.skeleton().find(n).unwrap())
+        .collect();
+    let mut lines = String::new();
+    for f in 0..motion.frame_count() {
+        let joints: Vec<String> = index
+            .iter()
+            .map(|&j| {
+                let p = fk.position(f, j) / 100.0;
+                format!("[{},{},{}]", p.x, p.y, p.z)
+            })
+            .collect();
+        lines += &format!(
+            "{{\"t\":{},\"joints\":[{}]}}\n",
+            first_time + f as f64 / 30.0,
+            joints.join(",")
+        );
+    }
+    std::fs::write(&bvh_as_jsonl, lines).unwrap();
+    let bvh_error = mean_distance(&bvh_as_jsonl, &sim.join("truth.jsonl"));
+    eprintln!("BVH vs ground truth: {:.1} mm", bvh_error * 1000.0);
+    assert!(bvh_error < error + 0.01, "{bvh_error} vs {error}");
+
+    // Calibration from the body, then a body file measured from the
+    // recordings, then fusion with both: it must run and give as many frames.
+    let rig = d.join("rig.toml");
+    let mut args = vec!["fuse".to_string(), "calibrate".into()];
+    args.extend(recordings(&sim));
+    args.extend(["--out", &s(&rig), "--json"].map(String::from));
+    let calibrated = json(&mocap(&args.iter().map(String::as_str).collect::<Vec<_>>()));
+    assert_eq!(calibrated["sensors"].as_array().unwrap().len(), 2);
+    let body = d.join("measured.json");
+    let mut args = vec!["fuse".to_string(), "measure".into()];
+    args.extend(recordings(&sim));
+    args.extend(["--out", &s(&body)].map(String::from));
+    let out = mocap(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut args = vec!["fuse".to_string(), "run".into()];
+    args.extend(recordings(&sim));
+    args.extend(
+        [
+            "--calib",
+            &s(&rig),
+            "--body",
+            &s(&body),
+            "--method",
+            "report",
+            "--out",
+            &s(&d.join("body-calibrated.bvh")),
+            "--json",
+        ]
+        .map(String::from),
+    );
+    let again = json(&mocap(&args.iter().map(String::as_str).collect::<Vec<_>>()));
+    assert_eq!(again["fused_frames"], report["fused_frames"]);
+}
+
+#[test]
+fn serve_and_send_over_loopback() {
+    let (dir, sim) = simulated(&[]);
+    let d = dir.path();
+    let live = d.join("live.jsonl");
+    let live_bvh = d.join("live.bvh");
+    let mut server = Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args([
+            "fuse",
+            "serve",
+            "--calib",
+            &s(&sim.join("truth.calib.toml")),
+            "--body",
+            &s(&sim.join("body.json")),
+            "--listen",
+            "127.0.0.1:0",
+            "--out",
+            &s(&live),
+            "--out",
+            &s(&live_bvh),
+            "--idle-exit",
+            "1",
+            "--duration",
+            "30",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The server says where it listens.
+    let mut lines = BufReader::new(server.stderr.take().unwrap()).lines();
+    let addr = loop {
+        let line = lines
+            .next()
+            .expect("the server prints its address")
+            .unwrap();
+        if let Some(rest) = line.split("listening on ").nth(1) {
+            break rest.split_whitespace().next().unwrap().to_string();
+        }
+    };
+    let started = Instant::now();
+    let mut args = vec!["fuse".to_string(), "send".into()];
+    args.extend(recordings(&sim));
+    args.extend(["--to", &addr, "--realtime", "--speed", "4", "--json"].map(String::from));
+    let sent = json(&mocap(&args.iter().map(String::as_str).collect::<Vec<_>>()));
+    let datagrams = sent["datagrams"].as_u64().unwrap();
+    assert!(datagrams > 500, "{sent}");
+    let out = server.wait_with_output().unwrap();
+    assert!(
+        started.elapsed() < Duration::from_secs(30),
+        "the server stops when the sender is done"
+    );
+    let report = json(&out);
+    let server_report = &report["server"];
+    assert_eq!(server_report["datagrams"].as_u64().unwrap(), datagrams);
+    assert_eq!(server_report["malformed"], 0);
+    assert!(
+        server_report["fused_frames"].as_u64().unwrap() > 180,
+        "{report}"
+    );
+    let error = mean_distance(&live, &sim.join("truth.jsonl"));
+    eprintln!("served fusion vs ground truth: {:.1} mm", error * 1000.0);
+    assert!(error < 0.08, "{error} m");
+    let motion = mocap_core::io::bvh::read_bvh(&live_bvh).unwrap();
+    assert!(motion.frame_count() > 180);
+}
+
+#[test]
+fn calibrate_one_room_scan_against_another() {
+    let (dir, sim) = simulated(&[]);
+    let rig = dir.path().join("scans.toml");
+    let out = mocap(&[
+        "fuse",
+        "calibrate",
+        "--points",
+        &s(&sim.join("sensor-0.ply")),
+        &s(&sim.join("sensor-1.ply")),
+        "--pairs",
+        &s(&sim.join("pairs-0-1.txt")),
+        "--out",
+        &s(&rig),
+        "--json",
+    ]);
+    let result = json(&out);
+    // Sensors around the person share little but the floor: ICP must say so.
+    assert!(!result["icp"]["unconstrained"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+    // Sensor 1's pose relative to sensor 0, against the truth.
+    use mocap_fuse::calib::Calibration;
+    let truth = Calibration::read(&sim.join("truth.calib.toml")).unwrap();
+    let relative = |c: &Calibration| c.get(0).unwrap().inverse().then_after(c.get(1).unwrap());
+    let expected = relative(&truth);
+    let found = relative(&Calibration::read(&rig).unwrap());
+    let (r, t) = (found.rotation, found.translation);
+    let (true_rotation, true_translation) = (expected.rotation, expected.translation);
+    let angle = r.angle_between(true_rotation).to_degrees();
+    let shift = (t - true_translation).length();
+    eprintln!("scan calibration off by {angle:.2} degrees, {shift:.3} m");
+    assert!(angle < 1.5, "{angle} degrees");
+    assert!(shift < 0.05, "{shift} m");
+}
+
+#[test]
+fn eval_on_ntu_files_without_ground_truth() {
+    let (_dir, sim) = simulated(&["--ntu"]);
+    let files: Vec<String> = (0..3)
+        .map(|k| s(&sim.join(format!("S001C{k:03}P001R001A001.skeleton"))))
+        .collect();
+    let mut args = vec!["fuse", "eval"];
+    args.extend(files.iter().map(String::as_str));
+    args.extend(["--json", "-"]);
+    let reports = json(&mocap(&args));
+    let report = &reports[0];
+    assert_eq!(report["sensors"].as_array().unwrap().len(), 3);
+    let rows = report["rows"].as_array().unwrap();
+    let std_of = |name: &str| {
+        rows.iter()
+            .find(|r| r["source"] == name)
+            .unwrap_or_else(|| panic!("no row {name}: {rows:?}"))["bone_std_mm"]
+            .as_f64()
+            .unwrap()
+    };
+    let best_single = (0..3)
+        .map(|k| std_of(&format!("sensor {k}")))
+        .fold(f64::MAX, f64::min);
+    let fused = std_of("fused (best)");
+    eprintln!("bone length std: best single sensor {best_single:.1} mm, fused {fused:.1} mm");
+    assert!(fused < best_single, "{fused} vs {best_single}");
+}
+
+#[test]
+fn eval_on_a_bvh_take_compares_methods_with_the_truth() {
+    let out = mocap(&[
+        "fuse",
+        "eval",
+        &sample(),
+        "--sensors",
+        "3",
+        "--seeds",
+        "1",
+        "--json",
+        "-",
+    ]);
+    let report = json(&out);
+    let results = report["results"].as_array().unwrap();
+    let mpjpe = |prefix: &str| {
+        results
+            .iter()
+            .find(|r| r["method"].as_str().unwrap().starts_with(prefix))
+            .unwrap()["mpjpe_mm"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(mpjpe("best:") < mpjpe("state only (report baseline)"));
+}
+
+#[test]
+fn errors_name_the_problem() {
+    let (dir, sim) = simulated(&[]);
+    // A calibration without sensor 2.
+    let partial = dir.path().join("partial.toml");
+    let text = std::fs::read_to_string(sim.join("truth.calib.toml")).unwrap();
+    let cut = text.find("[[sensor]]\nid = 2").unwrap();
+    std::fs::write(&partial, &text[..cut]).unwrap();
+    let mut args = vec!["fuse".to_string(), "run".into()];
+    args.extend(recordings(&sim));
+    args.extend(
+        [
+            "--calib",
+            &s(&partial),
+            "--out",
+            &s(&dir.path().join("x.jsonl")),
+        ]
+        .map(String::from),
+    );
+    let out = mocap(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("no pose for sensor(s) 2"),
+        "{}",
+        stderr(&out)
+    );
+    // An output of unknown type.
+    let out = mocap(&[
+        "fuse",
+        "run",
+        &recordings(&sim)[0],
+        "--calib",
+        &s(&sim.join("truth.calib.toml")),
+        "--out",
+        &s(&dir.path().join("x.csv")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains(".jsonl"), "{}", stderr(&out));
+    // A bad recording line.
+    let bad = dir.path().join("bad.jsonl");
+    std::fs::write(&bad, "{\"sensor\":0}\n").unwrap();
+    let out = mocap(&[
+        "fuse",
+        "measure",
+        &s(&bad),
+        "--out",
+        &s(&dir.path().join("b.json")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("bad.jsonl:1:"), "{}", stderr(&out));
+    // An unknown method is a usage error.
+    let out = mocap(&[
+        "fuse",
+        "run",
+        &recordings(&sim)[0],
+        "--calib",
+        "c.toml",
+        "--out",
+        "x.jsonl",
+        "--method",
+        "magic",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
