@@ -40,6 +40,8 @@ enum Command {
     View(commands::view::ViewArgs),
     /// Draw motions as a filmstrip PNG or an animated GIF.
     Render(commands::view::RenderArgs),
+    /// Run the whole pipeline (fuse, clean, search, restyle) on bundled data and write an HTML report.
+    Demo(commands::demo::Args),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
         Command::Search(args) => commands::search::run(args, &options),
         Command::View(args) => commands::view::view(args, &options),
         Command::Render(args) => commands::view::render(args, &options),
+        Command::Demo(args) => commands::demo::run(args, &options),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

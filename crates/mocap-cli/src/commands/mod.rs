@@ -2,6 +2,7 @@
 //! libraries.
 
 pub mod convert;
+pub mod demo;
 pub mod fuse;
 pub mod info;
 pub mod positions;
