@@ -640,6 +640,14 @@ pub struct BodySensorReport {
     /// Inliers of the best fit with this sensor's labels all mirrored, the
     /// hypothesis kept if it had had more.
     pub mirrored_inliers: usize,
+    /// A rough standard error of the fitted turn about the vertical (degrees):
+    /// `rms / (spread * sqrt(25))`, with `spread` the RMS horizontal distance
+    /// of the inlier joints from their mean. The errors that matter are each
+    /// joint's constant bias, repeated in every frame, so only the 25 joints
+    /// count as independent, not the frames. A person standing still (a bow)
+    /// spreads little and gives several degrees; capture a calibration take
+    /// in which the person walks and turns.
+    pub yaw_uncertainty_degrees: f64,
 }
 
 /// The result of a calibration from the body, with one report per sensor.
@@ -908,6 +916,24 @@ pub fn calibrate_from_body(
             }
         };
         let ((transform, inliers, rms), pairs) = best;
+        let yaw_uncertainty_degrees = {
+            let inlier2 = options.inlier_distance * options.inlier_distance;
+            let kept: Vec<Vec3> = src
+                .iter()
+                .zip(&dst)
+                .filter(|(p, q)| transform.apply(**p).distance_squared(**q) < inlier2)
+                .map(|(_, q)| *q)
+                .collect();
+            let n = kept.len().max(1) as f32;
+            let mean = kept.iter().copied().sum::<Vec3>() / n;
+            let spread = (kept
+                .iter()
+                .map(|q| (*q - mean).with_y(0.0).length_squared())
+                .sum::<f32>()
+                / n)
+                .sqrt() as f64;
+            (rms / (spread.max(1e-3) * (JOINT_COUNT as f64).sqrt())).to_degrees()
+        };
         calibration.set(SensorPose {
             id: sensor,
             transform,
@@ -923,6 +949,7 @@ pub fn calibrate_from_body(
             settled_frames,
             paired_frames,
             mirrored_inliers,
+            yaw_uncertainty_degrees,
         });
     }
     Ok(BodyCalibration {

@@ -793,12 +793,13 @@ pub fn consistency_markdown(reports: &[ConsistencyReport], command: &str) -> Str
         );
         for c in &r.calibration {
             s += &format!(
-                "sensor {} {} inliers of {} pairs (RMS {:.1} mm; mirrored hypothesis {} inliers); ",
+                "sensor {} {} inliers of {} pairs (RMS {:.1} mm; mirrored hypothesis {} inliers; turn known to about {:.1} degrees); ",
                 c.sensor,
                 c.inliers,
                 c.pairs,
                 c.rms * 1000.0,
-                c.mirrored_inliers
+                c.mirrored_inliers,
+                c.yaw_uncertainty_degrees
             );
         }
         s += "\n\n| source | frames | bone length std (mm) | std / length (%) | length error (mm) | jitter (mm/frame^2) |\n";

@@ -302,14 +302,22 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
     );
     for s in &found.sensors {
         println!(
-            "  sensor {}: {} of {} joint pairs fit within 10 cm (RMS {:.1} mm), {} of {} frames with settled left/right",
+            "  sensor {}: {} of {} joint pairs fit within 10 cm (RMS {:.1} mm), {} of {} frames with settled left/right, turn about the vertical known to about {:.1} degrees",
             s.sensor,
             s.inliers,
             s.pairs,
             s.rms * 1000.0,
             s.settled_frames,
-            s.paired_frames
+            s.paired_frames,
+            s.yaw_uncertainty_degrees
         );
+    }
+    if found
+        .sensors
+        .iter()
+        .any(|s| s.yaw_uncertainty_degrees > 5.0)
+    {
+        println!("warning: the person moved too little for a sure calibration from the body (over 5 degrees of doubt); capture a take where they walk and turn, or refine with room scans (--points)");
     }
     Ok(())
 }
