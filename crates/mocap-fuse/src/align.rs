@@ -609,6 +609,10 @@ pub struct BodyCalibrationOptions {
     pub inlier_distance: f32,
     pub ransac_iterations: usize,
     pub seed: u64,
+    /// Rounds of refinement against the fused skeleton of the other sensors
+    /// (see [`calibrate_from_body`]); 0 keeps the pairwise fit.
+    #[serde(default)]
+    pub consensus_rounds: usize,
 }
 
 impl Default for BodyCalibrationOptions {
@@ -618,6 +622,7 @@ impl Default for BodyCalibrationOptions {
             inlier_distance: 0.10,
             ransac_iterations: 400,
             seed: 7,
+            consensus_rounds: 2,
         }
     }
 }
@@ -952,11 +957,101 @@ pub fn calibrate_from_body(
             yaw_uncertainty_degrees,
         });
     }
+    for _ in 0..options.consensus_rounds {
+        refine_by_consensus(streams, &mut calibration, reference, options, &mut rng);
+    }
     Ok(BodyCalibration {
         calibration,
         reference,
         sensors: reports,
     })
+}
+
+/// One round of refinement: each sensor but the reference is fitted again,
+/// this time to the fused skeleton of all the other sensors (with the best
+/// fusion, left/right repaired) instead of to the reference alone. The
+/// consensus of several sensors has smaller joint biases than one sensor,
+/// and frames the reference could not settle still count. Each frame of the
+/// sensor takes the labelling (as reported or mirrored) closer to the
+/// consensus under the current transform. The pose is kept when the refit
+/// has fewer inliers than the current one.
+fn refine_by_consensus(
+    streams: &SensorStreams,
+    calibration: &mut Calibration,
+    reference: u16,
+    options: &BodyCalibrationOptions,
+    rng: &mut StdRng,
+) {
+    let body = crate::body::BodyModel::measure(
+        streams
+            .streams
+            .values()
+            .flat_map(|s| s.iter().map(|f| &f.joints)),
+        crate::body::MeasureOptions::default(),
+    );
+    let period = 1.0 / 30.0;
+    let inlier2 = options.inlier_distance * options.inlier_distance;
+    let ids: Vec<u16> = streams.streams.keys().copied().collect();
+    for &sensor in ids.iter().filter(|&&s| s != reference) {
+        let Some(current) = calibration.get(sensor).copied() else {
+            continue;
+        };
+        let others = SensorStreams {
+            streams: streams
+                .streams
+                .iter()
+                .filter(|(id, _)| **id != sensor)
+                .map(|(id, f)| (*id, f.clone()))
+                .collect(),
+        };
+        let mut fuser =
+            crate::fusion::Fuser::new(crate::fusion::FusionOptions::best(), body.clone());
+        let tracked = |a: &JointObservation| a.state == TrackingState::Tracked;
+        let (mut src, mut dst) = (Vec::new(), Vec::new());
+        for f in &streams.streams[&sensor] {
+            let views = crate::offline::views_at(&others, calibration, f.timestamp, period);
+            let Some(fused) = fuser.fuse(f.timestamp, &views) else {
+                continue;
+            };
+            let cost = |mirror: bool| -> f32 {
+                (0..JOINT_COUNT)
+                    .filter_map(|n| {
+                        let m = if mirror { MIRROR[n] } else { n };
+                        (tracked(&f.joints[m]) && fused.confidence[n] > 0.0).then(|| {
+                            current
+                                .apply(f.joints[m].position)
+                                .distance(fused.joints[n])
+                                .min(0.5)
+                        })
+                    })
+                    .sum()
+            };
+            let mirror = cost(true) < cost(false);
+            for n in 0..JOINT_COUNT {
+                let m = if mirror { MIRROR[n] } else { n };
+                if tracked(&f.joints[m]) && fused.confidence[n] > 0.0 {
+                    src.push(f.joints[m].position);
+                    dst.push(fused.joints[n]);
+                }
+            }
+        }
+        let inliers_now = src
+            .iter()
+            .zip(&dst)
+            .filter(|(p, q)| current.apply(**p).distance_squared(**q) < inlier2)
+            .count();
+        if let Some((transform, inliers, rms)) = robust_fit(&src, &dst, options, rng) {
+            if inliers >= inliers_now {
+                calibration.set(SensorPose {
+                    id: sensor,
+                    transform,
+                    method: Some("body (refined on the fused skeleton)".into()),
+                    rms_residual: Some(rms),
+                    pairs: Some(inliers),
+                });
+            }
+        }
+    }
 }
 
 #[cfg(test)]
