@@ -1027,8 +1027,8 @@ fn refine_by_consensus(
                     .sum()
             };
             let mirror = cost(true) < cost(false);
-            for n in 0..JOINT_COUNT {
-                let m = if mirror { MIRROR[n] } else { n };
+            for (n, &mirrored) in MIRROR.iter().enumerate() {
+                let m = if mirror { mirrored } else { n };
                 if tracked(&f.joints[m]) && fused.confidence[n] > 0.0 {
                     src.push(f.joints[m].position);
                     dst.push(fused.joints[n]);
