@@ -24,6 +24,7 @@
 //! - [`calib`], [`align`], [`ply`]: sensor poses, their file, and finding
 //!   them (point pairs, ICP on room scans, the body seen by two sensors);
 //! - [`bvh`]: fused joints as a BVH on a fitted skeleton;
+//! - [`output`]: fused frames to JSON lines and BVH files at once;
 //! - [`sim`]: a Kinect v2 simulator on ground-truth takes;
 //! - [`eval`]: evaluation against ground truth, and without it
 //!   (bone-length consistency of real captures).
