@@ -8,7 +8,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::Motion;
 use serde::{Deserialize, Serialize};
 
-use crate::{CleanError, Result};
+use crate::Result;
 
 /// Which set a take belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -68,49 +68,7 @@ pub fn split_of(take_name: &str, fractions: &SplitFractions) -> Split {
 /// The BVH files among `inputs` (files, or folders searched recursively),
 /// sorted by path.
 pub fn list_bvh(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
-        let entries = std::fs::read_dir(dir).map_err(|e| mocap_core::Error::io(dir, e))?;
-        for entry in entries {
-            let path = entry.map_err(|e| mocap_core::Error::io(dir, e))?.path();
-            if path.is_dir() {
-                walk(&path, out)?;
-            } else if is_bvh(&path) {
-                out.push(path);
-            }
-        }
-        Ok(())
-    }
-    let mut out = Vec::new();
-    for input in inputs {
-        if input.is_dir() {
-            walk(input, &mut out)?;
-        } else if input.is_file() {
-            out.push(input.clone());
-        } else {
-            return Err(CleanError::Invalid(format!(
-                "{}: no such file or folder",
-                input.display()
-            )));
-        }
-    }
-    out.sort();
-    out.dedup();
-    if out.is_empty() {
-        return Err(CleanError::Invalid(format!(
-            "no .bvh files in {}",
-            inputs
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    }
-    Ok(out)
-}
-
-fn is_bvh(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
+    Ok(mocap_core::io::find_bvh_files(inputs)?)
 }
 
 /// A clean take.

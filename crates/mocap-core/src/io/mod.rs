@@ -106,6 +106,47 @@ pub fn write_motion(path: &Path, motion: &Motion) -> Result<()> {
     }
 }
 
+/// The BVH files among `inputs` (files as given, folders searched
+/// recursively), sorted and without repeats. An input that does not exist,
+/// or no BVH file at all, is an error naming the inputs.
+pub fn find_bvh_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
+        let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+        for entry in entries {
+            let path = entry.map_err(|e| Error::io(dir, e))?.path();
+            if path.is_dir() {
+                walk(&path, out)?;
+            } else if extension(&path) == "bvh" {
+                out.push(path);
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            walk(input, &mut out)?;
+        } else if input.is_file() {
+            out.push(input.clone());
+        } else {
+            return Err(Error::Invalid(format!(
+                "{}: no such file or folder",
+                input.display()
+            )));
+        }
+    }
+    out.sort();
+    out.dedup();
+    if out.is_empty() {
+        let names: Vec<String> = inputs.iter().map(|p| p.display().to_string()).collect();
+        return Err(Error::Invalid(format!(
+            "no .bvh files in {}",
+            names.join(", ")
+        )));
+    }
+    Ok(out)
+}
+
 fn extension(path: &Path) -> String {
     path.extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
