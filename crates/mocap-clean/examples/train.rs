@@ -6,7 +6,7 @@
 //!     [--loss derivative|mse] [--representation rot6d|expmap|euler] \
 //!     [--width 64] [--levels 2] [--blocks 1] [--window 16] [--large] \
 //!     [--max-sigma 10] [--spike-probability 0.5] [--max-spikes 3] [--spike-sigma 16] \
-//!     [--max-train-takes N] [--state DIR] [--resume] [--device cpu|cuda] [--json REPORT.json]
+//!     [--position-weight W] [--max-train-takes N] [--state DIR] [--resume] [--device cpu|cuda] [--json REPORT.json]
 
 use std::path::PathBuf;
 
@@ -56,6 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--spike-sigma" => {
                 o.noise.spikes.as_mut().unwrap().duration_sigma_frames = next(&mut i)?.parse()?
             }
+            "--position-weight" => o.position_weight = next(&mut i)?.parse()?,
             "--max-train-takes" => o.max_train_takes = Some(next(&mut i)?.parse()?),
             "--validation-windows" => o.validation_windows = next(&mut i)?.parse()?,
             "--state" => o.state_dir = Some(PathBuf::from(next(&mut i)?)),

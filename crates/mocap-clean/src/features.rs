@@ -185,24 +185,107 @@ impl FeatureLayout {
     }
 
     /// Brings a window of features to a canonical range before it is fed to
-    /// the network, and returns what to add back afterwards. Only Euler
-    /// angles need it: whole turns are taken off so the first frame of each
-    /// channel lies in (-pi, pi].
-    pub fn recenter(&self, window: &mut [f32]) -> Vec<f32> {
+    /// the network, and returns what was done, to undo it on the output
+    /// ([`Recentering::undo`]) or do the same to the target
+    /// ([`Recentering::apply`]).
+    ///
+    /// - Euler angles: whole turns are taken off so that the first frame of
+    ///   each channel lies in (-pi, pi].
+    /// - Exponential maps: a joint whose first vector is longer than pi (the
+    ///   take-level encoding is sign-continuous, so a joint that turned
+    ///   through 180 degrees earlier in the take carries vectors up to 2 pi
+    ///   long) is switched to the other branch (`v - 2 pi v/|v|`, the same
+    ///   rotation) in the whole window. Training windows are encoded on
+    ///   their own and always start within pi; without this, inference
+    ///   would feed vectors the network never saw.
+    /// - 6D: nothing.
+    pub fn recenter(&self, window: &mut [f32]) -> Recentering {
         let c = self.channels();
-        let mut offsets = vec![0.0; c];
-        if self.representation == Representation::Euler && window.len() >= c {
-            let tau = std::f32::consts::TAU;
-            for (ch, offset) in offsets.iter_mut().enumerate() {
-                *offset = (window[ch] / tau).round() * tau;
+        if window.len() < c {
+            return Recentering::None;
+        }
+        let recentering = match self.representation {
+            Representation::Rot6d => Recentering::None,
+            Representation::Euler => {
+                let tau = std::f32::consts::TAU;
+                Recentering::Offsets(
+                    window[..c]
+                        .iter()
+                        .map(|v| (v / tau).round() * tau)
+                        .collect(),
+                )
             }
-            for frame in window.chunks_mut(c) {
-                for (v, o) in frame.iter_mut().zip(&offsets) {
-                    *v -= o;
+            Representation::ExpMap => Recentering::Flipped(
+                window[..c]
+                    .chunks(3)
+                    .map(|v| Vec3::new(v[0], v[1], v[2]).length() > std::f32::consts::PI)
+                    .collect(),
+            ),
+        };
+        recentering.apply(window);
+        recentering
+    }
+
+    /// Puts the target window `target` on the same branch as the input window
+    /// `input` (both frame after frame, encoded from the clean and the noisy
+    /// copy of the same frames).
+    ///
+    /// Euler angles and exponential maps name one rotation with several
+    /// vectors (whole turns; `v` and `v - 2 pi v/|v|`). The clean and the noisy
+    /// window are encoded separately, so near 180 degrees they can land on
+    /// different branches: a joint at 179 degrees in the clean take and 181
+    /// in the noisy copy gives a target 358 degrees away from the input for
+    /// a 2 degree error. Training on such pairs asks the network for a jump
+    /// that has nothing to do with the noise. Here each Euler channel of the
+    /// target is shifted by the whole number of turns closest to its mean
+    /// difference from the input, and each exponential-map joint of the
+    /// target is switched to the other branch over the whole window when
+    /// that brings it closer to the input (the window stays continuous
+    /// along time: switching all frames of a sign-continuous track is
+    /// negating all its quaternions).
+    pub fn align_target(&self, input: &[f32], target: &mut [f32]) {
+        let c = self.channels();
+        if c == 0 || input.len() != target.len() {
+            return;
+        }
+        let frames = input.len() / c;
+        match self.representation {
+            Representation::Rot6d => {}
+            Representation::Euler => {
+                let tau = std::f32::consts::TAU;
+                for ch in 0..c {
+                    let mean = (0..frames)
+                        .map(|f| input[f * c + ch] - target[f * c + ch])
+                        .sum::<f32>()
+                        / frames.max(1) as f32;
+                    let shift = (mean / tau).round() * tau;
+                    if shift != 0.0 {
+                        for f in 0..frames {
+                            target[f * c + ch] += shift;
+                        }
+                    }
+                }
+            }
+            Representation::ExpMap => {
+                for k in 0..self.joints.len() {
+                    let (mut same, mut flipped) = (0.0f32, 0.0f32);
+                    for f in 0..frames {
+                        let at = f * c + 3 * k;
+                        let x = Vec3::from_slice(&input[at..at + 3]);
+                        let y = Vec3::from_slice(&target[at..at + 3]);
+                        same += (x - y).length_squared();
+                        flipped += (x - other_branch(y)).length_squared();
+                    }
+                    if flipped < same {
+                        for f in 0..frames {
+                            let at = f * c + 3 * k;
+                            let y = other_branch(Vec3::from_slice(&target[at..at + 3]));
+                            target[at..at + 3].copy_from_slice(&y.to_array());
+                        }
+                    }
                 }
             }
         }
-        offsets
     }
 
     /// The local rotation of feature joint `k` from one frame's features.
@@ -226,6 +309,78 @@ impl FeatureLayout {
                 let q = self.rotation(frame, k);
                 motion.set_local_rotation(f, j, q);
             }
+        }
+    }
+}
+
+/// The other exponential-map vector of the same rotation: `v - 2 pi v/|v|`
+/// (a rotation by `theta` about `n` is one by `theta - 2 pi` about `n`). For
+/// lengths in (0, 2 pi) applying it twice gives `v` back.
+fn other_branch(v: Vec3) -> Vec3 {
+    let length = v.length();
+    if length < 1e-6 {
+        // Near the identity the other branch is a full turn about an
+        // undefined axis; keep the short vector.
+        v
+    } else {
+        v * (1.0 - std::f32::consts::TAU / length)
+    }
+}
+
+/// What [`FeatureLayout::recenter`] did to a window.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Recentering {
+    /// Nothing (6D features).
+    None,
+    /// Whole turns taken off each Euler channel.
+    Offsets(Vec<f32>),
+    /// Exponential-map joints switched to their other branch.
+    Flipped(Vec<bool>),
+}
+
+impl Recentering {
+    /// Does the same to another window of the same layout (frame after frame).
+    pub fn apply(&self, window: &mut [f32]) {
+        match self {
+            Recentering::None => {}
+            Recentering::Offsets(offsets) => {
+                for frame in window.chunks_mut(offsets.len()) {
+                    for (v, o) in frame.iter_mut().zip(offsets) {
+                        *v -= o;
+                    }
+                }
+            }
+            Recentering::Flipped(flipped) => flip(flipped, window),
+        }
+    }
+
+    /// Undoes it on a window (the network's output): the features are back
+    /// on the branch of the take they came from, so overlapping windows
+    /// blend on one branch.
+    pub fn undo(&self, window: &mut [f32]) {
+        match self {
+            Recentering::None => {}
+            Recentering::Offsets(offsets) => {
+                for frame in window.chunks_mut(offsets.len()) {
+                    for (v, o) in frame.iter_mut().zip(offsets) {
+                        *v += o;
+                    }
+                }
+            }
+            // Switching branch is its own inverse.
+            Recentering::Flipped(flipped) => flip(flipped, window),
+        }
+    }
+}
+
+fn flip(flipped: &[bool], window: &mut [f32]) {
+    if !flipped.iter().any(|&f| f) {
+        return;
+    }
+    for frame in window.chunks_mut(3 * flipped.len()) {
+        for (k, _) in flipped.iter().enumerate().filter(|(_, &f)| f) {
+            let v = other_branch(Vec3::from_slice(&frame[3 * k..3 * k + 3]));
+            frame[3 * k..3 * k + 3].copy_from_slice(&v.to_array());
         }
     }
 }
@@ -268,11 +423,108 @@ mod tests {
         let mut window = layout.encode(&motion);
         window[0] += 4.0 * std::f32::consts::PI;
         let original = window.clone();
-        let offsets = layout.recenter(&mut window);
+        let recentering = layout.recenter(&mut window);
         assert!(window[0].abs() <= std::f32::consts::PI + 1e-5);
-        for (i, v) in window.iter().enumerate() {
-            let o = offsets[i % layout.channels()];
-            assert!((v + o - original[i]).abs() < 1e-4);
+        let mut back = window.clone();
+        recentering.undo(&mut back);
+        for (v, o) in back.iter().zip(&original) {
+            assert!((v - o).abs() < 1e-4);
+        }
+    }
+
+    /// Largest feature distance and largest rotation change of joint 1
+    /// between two feature windows.
+    fn joint1_gap(layout: &FeatureLayout, a: &[f32], b: &[f32]) -> (f32, f32) {
+        let (c, dim) = (layout.channels(), layout.representation.dim());
+        let (mut feature, mut angle) = (0.0f32, 0.0f32);
+        for f in 0..a.len() / c {
+            for i in dim..2 * dim {
+                feature = feature.max((a[f * c + i] - b[f * c + i]).abs());
+            }
+            let qa = layout.rotation(&a[f * c..(f + 1) * c], 1);
+            let qb = layout.rotation(&b[f * c..(f + 1) * c], 1);
+            angle = angle.max(mocap_core::rotation::angle_between(qa, qb).to_degrees());
+        }
+        (feature, angle)
+    }
+
+    #[test]
+    fn euler_targets_are_put_on_the_inputs_turn() {
+        // Joint 1 (Z X Y channels) at Y = 179 degrees in the clean take and
+        // -179 (= 181) in the noisy one: 2 degrees apart as rotations.
+        let clean = synthetic_motion(8, 3);
+        let mut noisy = clean.clone();
+        let mut clean = clean;
+        let y_slot = clean.skeleton().channel_start(1) + 2;
+        for f in 0..8 {
+            clean.frame_mut(f)[y_slot] = 179.0;
+            noisy.frame_mut(f)[y_slot] = -179.0;
+        }
+        let layout = FeatureLayout::new(clean.skeleton(), Representation::Euler).unwrap();
+        let x = layout.encode(&noisy);
+        let mut y = layout.encode(&clean);
+        let original = y.clone();
+        layout.align_target(&x, &mut y);
+        let (feature, angle) = joint1_gap(&layout, &x, &y);
+        assert!(feature < 0.04, "target still {feature} rad from the input");
+        assert!((angle - 2.0).abs() < 0.01, "{angle}");
+        // The aligned target is the same rotation as the clean take.
+        assert!(joint1_gap(&layout, &original, &y).1 < 0.01);
+    }
+
+    #[test]
+    fn expmap_targets_are_put_on_the_inputs_branch() {
+        let y_axis = Vec3::new(0.0, 1.0, 0.0);
+        let mut clean = synthetic_motion(8, 3);
+        let mut noisy = clean.clone();
+        for f in 0..8 {
+            clean.set_local_rotation(f, 1, Quat::from_axis_angle(y_axis, 179f32.to_radians()));
+            noisy.set_local_rotation(f, 1, Quat::from_axis_angle(y_axis, 181f32.to_radians()));
+        }
+        let layout = FeatureLayout::new(clean.skeleton(), Representation::ExpMap).unwrap();
+        let x = layout.encode(&noisy);
+        let mut y = layout.encode(&clean);
+        let original = y.clone();
+        // Encoded on their own, the two land on opposite branches.
+        assert!(joint1_gap(&layout, &x, &original).0 > 6.0);
+        layout.align_target(&x, &mut y);
+        let (feature, angle) = joint1_gap(&layout, &x, &y);
+        assert!(feature < 0.04, "target still {feature} rad from the input");
+        assert!((angle - 2.0).abs() < 0.01, "{angle}");
+        assert!(joint1_gap(&layout, &original, &y).1 < 0.01);
+    }
+
+    #[test]
+    fn expmap_windows_past_half_a_turn_are_recentered_and_restored() {
+        // Joint 1 turns about Y from 150 to 240 degrees over the take: the
+        // take-level encoding is continuous, so its vectors pass pi.
+        let mut motion = synthetic_motion(16, 3);
+        let y_axis = Vec3::new(0.0, 1.0, 0.0);
+        for f in 0..16 {
+            let angle = (150.0 + 6.0 * f as f32).to_radians();
+            motion.set_local_rotation(f, 1, Quat::from_axis_angle(y_axis, angle));
+        }
+        let layout = FeatureLayout::new(motion.skeleton(), Representation::ExpMap).unwrap();
+        let features = layout.encode(&motion);
+        let c = layout.channels();
+        let length = |w: &[f32], f: usize| Vec3::from_slice(&w[f * c + 3..f * c + 6]).length();
+        // A window starting at frame 8 (198 degrees).
+        let original = features[8 * c..].to_vec();
+        assert!(length(&original, 0) > std::f32::consts::PI);
+        let mut window = original.clone();
+        let recentering = layout.recenter(&mut window);
+        assert_eq!(recentering, Recentering::Flipped(vec![false, true, false]));
+        assert!(length(&window, 0) <= std::f32::consts::PI);
+        // Same rotations, and still continuous along time.
+        assert!(joint1_gap(&layout, &original, &window).1 < 0.01);
+        for f in 1..8 {
+            let step = Vec3::from_slice(&window[f * c + 3..f * c + 6])
+                - Vec3::from_slice(&window[(f - 1) * c + 3..(f - 1) * c + 6]);
+            assert!(step.length() < 0.2, "frame {f}: step {}", step.length());
+        }
+        recentering.undo(&mut window);
+        for (a, b) in window.iter().zip(&original) {
+            assert!((a - b).abs() < 1e-4);
         }
     }
 }

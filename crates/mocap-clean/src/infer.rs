@@ -166,13 +166,21 @@ impl CleanModel {
             let y: Vec<f32> = output
                 .try_to_vec()
                 .map_err(|e| CleanError::Invalid(format!("reading the network output: {e:?}")))?;
-            for (b, offset) in offsets.iter().enumerate() {
+            let mut out_window = vec![0.0; t * c];
+            for (b, recentering) in offsets.iter().enumerate() {
+                for f in 0..t {
+                    for ch in 0..c {
+                        out_window[f * c + ch] = y[(b * c + ch) * t + f];
+                    }
+                }
+                // Back on the take's branch before blending.
+                recentering.undo(&mut out_window);
                 let s = (start_index + b) * hop;
                 for f in 0..t {
                     let w = weight[f];
                     weight_sum[s + f] += w;
                     for ch in 0..c {
-                        sum[(s + f) * c + ch] += w * (y[(b * c + ch) * t + f] + offset[ch]);
+                        sum[(s + f) * c + ch] += w * out_window[f * c + ch];
                     }
                 }
             }

@@ -30,6 +30,7 @@ pub mod dataset;
 pub mod eval;
 pub mod features;
 pub mod filters;
+pub mod fk;
 pub mod infer;
 pub mod loss;
 pub mod model;

@@ -13,6 +13,8 @@
 use burn::tensor::Tensor;
 use serde::{Deserialize, Serialize};
 
+use crate::fk::FkSkeleton;
+
 /// Weights of the loss terms and the frame rate the differences use.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LossWeights {
@@ -70,6 +72,16 @@ pub fn derivative_loss(pred: Tensor<3>, target: Tensor<3>, w: &LossWeights) -> T
         loss = loss + acceleration.powi_scalar(2).mean() * w.beta;
     }
     loss
+}
+
+/// The position term: mean squared difference of the root-relative joint
+/// positions that forward kinematics gives for the predicted and the target
+/// 6D features (skeleton units squared, per coordinate). The training loss
+/// adds it with weight `position_weight` (`TrainOptions`).
+pub fn position_loss(fk: &FkSkeleton, pred: Tensor<3>, target: Tensor<3>) -> Tensor<1> {
+    (fk.positions(pred) - fk.positions(target))
+        .powi_scalar(2)
+        .mean()
 }
 
 #[cfg(test)]

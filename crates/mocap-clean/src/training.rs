@@ -30,7 +30,8 @@ use crate::dataset::{
     SplitFractions, Take,
 };
 use crate::features::{FeatureLayout, Representation};
-use crate::loss::{derivative_loss, LossWeights};
+use crate::fk::FkSkeleton;
+use crate::loss::{derivative_loss, position_loss, LossWeights};
 use crate::model::{Denoiser, DenoiserConfig};
 use crate::noise::{add_noise, NoiseConfig};
 use crate::{CleanError, Result};
@@ -87,6 +88,11 @@ pub struct TrainOptions {
     pub plot: Option<PathBuf>,
     /// Use at most this many training takes (quick runs and tests).
     pub max_train_takes: Option<usize>,
+    /// Weight of the position term of the loss (forward kinematics of the
+    /// 6D features on the first training take's skeleton, see `fk.rs`), per
+    /// squared skeleton unit; 0 leaves it out (the report's loss).
+    #[serde(default)]
+    pub position_weight: f32,
 }
 
 impl Default for TrainOptions {
@@ -114,6 +120,7 @@ impl Default for TrainOptions {
             device: DeviceChoice::Cpu,
             plot: None,
             max_train_takes: None,
+            position_weight: 0.0,
         }
     }
 }
@@ -225,13 +232,11 @@ impl<'a> WindowSampler<'a> {
                 let (noisy, clean) = self.sample_motion(&mut rng)?;
                 let mut xf = self.layout.encode(&noisy);
                 let mut yf = self.layout.encode(&clean);
-                // Euler windows: the same whole turns off input and target.
-                let offsets = self.layout.recenter(&mut xf);
-                for frame in yf.chunks_mut(c) {
-                    for (v, o) in frame.iter_mut().zip(&offsets) {
-                        *v -= o;
-                    }
-                }
+                // Euler angles and exponential maps: the target on the
+                // input's branch, then both brought to the canonical range
+                // the same way (see `FeatureLayout::align_target`).
+                self.layout.align_target(&xf, &mut yf);
+                self.layout.recenter(&mut xf).apply(&mut yf);
                 Ok((xf, yf))
             })
             .collect::<Result<Vec<_>>>()?;
@@ -342,6 +347,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         held_out,
     };
 
+    let fk = if options.position_weight > 0.0 {
+        Some(FkSkeleton::new(first.motion.skeleton(), &layout)?)
+    } else {
+        None
+    };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?;
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?;
     let shape = [options.batch_size, network.channels, network.window];
@@ -399,6 +409,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             "batch_size": options.batch_size,
             "learning_rate": options.learning_rate,
             "seed": options.seed,
+            "position_weight": options.position_weight,
             "history": history,
         }),
     };
@@ -438,7 +449,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             run.data_seconds += data_start.elapsed().as_secs_f64();
             let model = run.model.take().expect("model present");
             let pred = model.forward(tensor(x, shape, &device));
-            let l = derivative_loss(pred, tensor(y, shape, &device), &loss);
+            let target = tensor(y, shape, &device);
+            let mut l = derivative_loss(pred.clone(), target.clone(), &loss);
+            if let Some(fk) = &fk {
+                l = l + position_loss(fk, pred, target) * options.position_weight;
+            }
             let value: f32 = l.clone().into_scalar();
             if !value.is_finite() {
                 return Err(CleanError::Invalid(format!(
