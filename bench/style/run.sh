@@ -4,6 +4,10 @@
 #
 #   bash bench/style/run.sh            # eval + speed with the shipped model
 #   bash bench/style/run.sh --train    # retrain models/style-default.safetensors first
+#   bash bench/style/run.sh --classifiers  # also compare the evaluation's classifiers
+#                                          # on real clips (held out + cross-validation)
+#   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
+# (flags combine)
 #
 # Build profile: `--profile test` (dependencies at opt-level 2 from the dev
 # profile, the workspace crates at opt-level 1), because a release build of
@@ -12,14 +16,19 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 DATA=${MOCAP_SHARED_DATA:-../shared/data}/bandai
-export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target}
+# target-style holds the test-profile builds of this crate (shared machine:
+# one build directory for this benchmark, not a second copy of burn).
+export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target-style}
 cargo build -q --profile test -p mocap-style --examples
 BIN=$CARGO_TARGET_DIR/debug/examples
 WALKS=walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right
 OUT=bench/style/out
 mkdir -p "$OUT"
 
-if [[ "${1:-}" == "--train" ]]; then
+ARGS=" $* "
+flag() { [[ "$ARGS" == *" $1 "* ]]; }
+
+if flag --train; then
   # The shipped default: the report's setting (240-frame windows, batch 16,
   # Adam, lr 1e-4), walking takes of both sets without the held-out takes,
   # with mirrored copies, seed 1.
@@ -30,9 +39,34 @@ if [[ "${1:-}" == "--train" ]]; then
   rm -rf models/style-default.png models/style-default.state
 fi
 
+if flag --classifiers; then
+  # The evaluation's classifiers on real clips only (no restyling): held-out
+  # accuracy and cross-validation on the training clips (style: leave one
+  # content out; content: leave one style out), current defaults (gait
+  # descriptor for both) against the previous ones (pose statistics for
+  # style, interval means for content). Content cross-validation on
+  # dataset-2 (921 clips, 7 folds) is left out for time.
+  C=$BIN/classifiers
+  "$C" --cv --classifier-contents "$WALKS" "$DATA/dataset-1" > "$OUT/classifiers-d1.json"
+  "$C" --cv --classifier-contents "$WALKS" --style-descriptor statistics \
+    --content-descriptor intervals "$DATA/dataset-1" > "$OUT/classifiers-d1-previous.json"
+  "$C" --cv-style --classifier-contents "$WALKS" "$DATA/dataset-2" > "$OUT/classifiers-d2.json"
+  "$C" --cv-style --classifier-contents "$WALKS" --style-descriptor statistics \
+    --content-descriptor intervals "$DATA/dataset-2" > "$OUT/classifiers-d2-previous.json"
+fi
+
 "$BIN/eval" --sources walk,walk-turn-left,walk-turn-right --styles walk \
   --classifier-contents "$WALKS" --filmstrips bench/style/filmstrips \
   --json "$OUT/eval.json" --markdown "$OUT/eval.md" "$DATA/dataset-1" "$DATA/dataset-2"
 
 "$BIN/speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
   "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 | tee "$OUT/speed.md"
+
+if flag --patches; then
+  # Sensitivity to the patch length (the default, 32, is the main run).
+  for P in 16 24 48; do
+    "$BIN/eval" --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+      --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-p$P.json" \
+      --markdown "$OUT/eval-p$P.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  done
+fi

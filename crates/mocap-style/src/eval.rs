@@ -5,9 +5,12 @@
 //!
 //! 1. The held-out takes ([`crate::data::held_out`], never seen by the
 //!    shipped model) are the test clips; the others train two independent
-//!    classifiers, one of style and one of content: the random forests of
-//!    `mocap-search` over body-relative pose features (not the
-//!    autoencoder's features, so the classifiers do not share its biases).
+//!    classifiers, one of style and one of content ([`crate::classify`]):
+//!    the random forests of `mocap-search` over windows of its body-relative
+//!    pose features, described by posture, rates of change, walking speed,
+//!    step period and spectra (not the autoencoder's features, so the
+//!    classifiers do not share its biases). They are chosen on real clips
+//!    ([`check_classifiers`]), never on the method's outputs.
 //! 2. Every pair (source, style clip) of test clips, the source's content in
 //!    `source_contents` and the style clip's in `style_contents`, is
 //!    restyled with every method ([`Method`]).
@@ -27,13 +30,10 @@ use std::time::Instant;
 use mocap_core::metrics::jitter;
 use mocap_core::{forward_kinematics, Motion};
 use mocap_nn::device::DeviceChoice;
-use mocap_search::features::motion_features;
-use mocap_search::forest::Samples;
-use mocap_search::intervals::FeatureSequence;
-use mocap_search::{build_index, Clip as SearchClip, Forest, ForestConfig, Index, IndexConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
+pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter};
 use crate::features::{up_axis, RigLayout};
@@ -43,6 +43,7 @@ use crate::{invalid, Result};
 
 /// Options of `mocap style eval`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(default)]
 pub struct EvalOptions {
     /// Folders or files of labelled clips (`<set>_<content>_<style>_<take>.bvh`).
     pub inputs: Vec<PathBuf>,
@@ -61,10 +62,23 @@ pub struct EvalOptions {
     pub convert: ConvertOptions,
     /// Trees of each classifier's forest.
     pub trees: usize,
+    /// The style classifier's model.
+    pub style_model: Model,
+    /// The content classifier's model.
+    pub content_model: Model,
     /// What the style classifier sees.
     pub style_descriptor: Descriptor,
     /// What the content classifier sees.
     pub content_descriptor: Descriptor,
+    /// Windows of the style classifier.
+    pub style_windows: Windows,
+    /// Windows of the content classifier.
+    pub content_windows: Windows,
+    /// Train the style classifier on the mirror images of its clips too.
+    pub style_mirror_training: bool,
+    /// Candidate features per tree node of both forests (the search
+    /// crate's default when `None`).
+    pub candidates: Option<usize>,
     pub seed: u64,
     /// Folder for filmstrip PNGs (none when `None`).
     pub filmstrips: Option<PathBuf>,
@@ -84,8 +98,14 @@ impl Default for EvalOptions {
             classifier_filter: ClipFilter::default(),
             convert: ConvertOptions::default(),
             trees: 100,
-            style_descriptor: Descriptor::Statistics,
-            content_descriptor: Descriptor::Intervals,
+            style_model: Model::Forest,
+            content_model: Model::Forest,
+            style_descriptor: Descriptor::Gait,
+            content_descriptor: Descriptor::Gait,
+            style_windows: Windows::default(),
+            content_windows: Windows::default(),
+            style_mirror_training: false,
+            candidates: None,
             seed: 1,
             filmstrips: None,
             filmstrip_count: 3,
@@ -176,163 +196,6 @@ pub struct EvalReport {
     pub options: EvalOptions,
     pub sets: Vec<SetReport>,
     pub seconds: f64,
-}
-
-/// What the classifiers' forests see of a window of a clip.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Descriptor {
-    /// mocap-search's own rows: the window resampled to 10 frames and the
-    /// means of every feature over every interval of them (pose over time).
-    Intervals,
-    /// The mean and standard deviation of every feature over the window
-    /// (pose statistics, independent of timing).
-    Statistics,
-}
-
-/// A random-forest classifier of clips (mocap-search's forest over its
-/// body-relative pose features), trained on windows of the training clips
-/// and voting over the windows of a clip: with a few takes per style,
-/// windows give the forest many more samples, and the vote makes a clip's
-/// label robust to one odd stride.
-enum ClipClassifier {
-    Intervals(Index),
-    Statistics {
-        forest: Forest,
-        classes: Vec<String>,
-    },
-}
-
-/// Window length and hop of the classifiers, seconds.
-const CLASSIFIER_WINDOW: f64 = 2.0;
-const CLASSIFIER_HOP: f64 = 0.5;
-
-/// The windows of a clip's per-frame features (the whole clip when it is
-/// shorter than a window).
-fn feature_windows(motion: &Motion) -> Result<Vec<FeatureSequence>> {
-    let features = motion_features(motion).map_err(search_error)?;
-    let frames = features.frame_count();
-    let window = ((CLASSIFIER_WINDOW * motion.fps()).round() as usize).max(2);
-    let hop = ((CLASSIFIER_HOP * motion.fps()).round() as usize).max(1);
-    if frames <= window {
-        return Ok(vec![features]);
-    }
-    let d = features.dim;
-    let mut out = Vec::new();
-    let mut start = 0;
-    loop {
-        let s = start.min(frames - window);
-        out.push(FeatureSequence {
-            dim: d,
-            values: features.values[s * d..(s + window) * d].to_vec(),
-        });
-        if s + window >= frames {
-            break;
-        }
-        start += hop;
-    }
-    Ok(out)
-}
-
-/// Mean and standard deviation of every feature over a window.
-fn statistics_row(w: &FeatureSequence) -> Vec<f32> {
-    let n = w.frame_count().max(1) as f64;
-    let mut row = vec![0.0f32; 2 * w.dim];
-    for i in 0..w.dim {
-        let mean = (0..w.frame_count())
-            .map(|f| w.values[f * w.dim + i] as f64)
-            .sum::<f64>()
-            / n;
-        let var = (0..w.frame_count())
-            .map(|f| (w.values[f * w.dim + i] as f64 - mean).powi(2))
-            .sum::<f64>()
-            / n;
-        row[i] = mean as f32;
-        row[w.dim + i] = var.sqrt() as f32;
-    }
-    row
-}
-
-impl ClipClassifier {
-    fn train(
-        clips: &[(&Clip, String)],
-        descriptor: Descriptor,
-        trees: usize,
-        seed: u64,
-    ) -> Result<ClipClassifier> {
-        let forest = ForestConfig {
-            trees,
-            seed,
-            ..ForestConfig::default()
-        };
-        let mut windows = Vec::new();
-        for (clip, label) in clips {
-            for features in feature_windows(&clip.motion)? {
-                windows.push((clip, label, features));
-            }
-        }
-        match descriptor {
-            Descriptor::Intervals => {
-                let rows: Vec<SearchClip> = windows
-                    .into_iter()
-                    .map(|(clip, label, features)| SearchClip {
-                        path: clip.path.clone(),
-                        label: label.clone(),
-                        performer: None,
-                        fps: clip.motion.fps(),
-                        features,
-                    })
-                    .collect();
-                let config = IndexConfig {
-                    forest,
-                    ..IndexConfig::default()
-                };
-                let index =
-                    build_index(&rows, "file name", &config, false).map_err(search_error)?;
-                Ok(ClipClassifier::Intervals(index))
-            }
-            Descriptor::Statistics => {
-                let mut classes: Vec<String> = windows.iter().map(|w| w.1.clone()).collect();
-                classes.sort();
-                classes.dedup();
-                let labels: Vec<u32> = windows
-                    .iter()
-                    .map(|w| classes.binary_search(w.1).expect("listed") as u32)
-                    .collect();
-                let rows: Vec<f32> = windows.iter().flat_map(|w| statistics_row(&w.2)).collect();
-                let dim = rows.len() / labels.len().max(1);
-                let samples = Samples::new(&rows, dim, &labels, classes.len()).map_err(invalid)?;
-                let forest = Forest::train(&samples, &forest, &|| {});
-                Ok(ClipClassifier::Statistics { forest, classes })
-            }
-        }
-    }
-
-    /// The class with the largest summed forest histogram over the clip's
-    /// windows.
-    fn predict(&self, motion: &Motion) -> Result<String> {
-        let classes = match self {
-            ClipClassifier::Intervals(index) => &index.classes,
-            ClipClassifier::Statistics { classes, .. } => classes,
-        };
-        let mut votes = vec![0.0f32; classes.len()];
-        for features in feature_windows(motion)? {
-            let histogram = match self {
-                ClipClassifier::Intervals(index) => index.describe(&features).histogram,
-                ClipClassifier::Statistics { forest, .. } => {
-                    forest.predict(&statistics_row(&features))
-                }
-            };
-            for (v, h) in votes.iter_mut().zip(&histogram) {
-                *v += h;
-            }
-        }
-        Ok(classes[mocap_search::forest::argmax(&votes)].clone())
-    }
-}
-
-fn search_error(e: mocap_search::SearchError) -> crate::StyleError {
-    invalid(format!("classifier: {e}"))
 }
 
 /// The gait period in seconds: the lag of the strongest autocorrelation of
@@ -461,6 +324,204 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     })
 }
 
+/// The evaluation classifiers' accuracy on real clips of one set, without
+/// restyling anything: to compare classifiers, see [`check_classifiers`].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ClassifierCheck {
+    pub set: String,
+    /// On the held-out clips (style: those of the classifier's contents),
+    /// trained on all the others, as in [`evaluate`].
+    pub held_out_style: f64,
+    pub held_out_style_clips: usize,
+    pub held_out_content: f64,
+    pub held_out_content_clips: usize,
+    /// Cross-validation on the training clips only (the held-out clips are
+    /// not used): style leaving one content out at a time (a style must be
+    /// recognised in a content it was not trained on), content leaving one
+    /// style out at a time. `None` when not asked for.
+    pub cross_validated_style: Option<f64>,
+    pub cross_validated_content: Option<f64>,
+    /// The held-out clips the style classifier got wrong, with its answer.
+    pub style_errors: Vec<(String, String)>,
+    /// The same for the content classifier.
+    pub content_errors: Vec<(String, String)>,
+}
+
+/// Which cross-validations [`check_classifiers`] runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CrossValidate {
+    pub style: bool,
+    pub content: bool,
+}
+
+/// Measures the classifiers of [`evaluate`] on real clips of every set of
+/// `options.inputs` (held-out accuracy and, as asked,
+/// cross-validation on the training clips), so that the evaluation's
+/// classifiers can be chosen on real clips, never on the method's outputs.
+pub fn check_classifiers(
+    options: &EvalOptions,
+    cross_validate: CrossValidate,
+) -> Result<Vec<ClassifierCheck>> {
+    let files = labelled_paths(&list_bvh(&options.inputs)?, &ClipFilter::default())?;
+    let mut sets: BTreeMap<String, Vec<(PathBuf, crate::data::Labels)>> = BTreeMap::new();
+    for f in files {
+        sets.entry(f.1.set.clone()).or_default().push(f);
+    }
+    let mut out = Vec::new();
+    for (set, files) in sets {
+        let held = held_out(&files);
+        let (test, train): (Vec<_>, Vec<_>) = files.iter().cloned().partition(|(p, _)| {
+            held.contains(
+                &p.file_stem()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
+            )
+        });
+        let train = load_clips(&train)?;
+        let test = load_clips(&test)?;
+        let (style, content) = train_classifiers(&train, options)?;
+        let style_tests: Vec<&Clip> = test
+            .iter()
+            .filter(|c| options.classifier_filter.accepts(&c.labels))
+            .collect();
+        let mut style_errors = Vec::new();
+        for c in &style_tests {
+            let p = style.predict(&c.motion)?;
+            if p != c.labels.style {
+                style_errors.push((c.name.clone(), p));
+            }
+        }
+        let mut content_errors = Vec::new();
+        for c in &test {
+            let p = content.predict(&c.motion)?;
+            if p != c.labels.content {
+                content_errors.push((c.name.clone(), p));
+            }
+        }
+        let style_hits = style_tests.len() - style_errors.len();
+        let content_hits = test.len() - content_errors.len();
+        let (mut cv_style, mut cv_content) = (None, None);
+        if cross_validate.style {
+            let style_clips: Vec<Clip> = train
+                .iter()
+                .filter(|c| options.classifier_filter.accepts(&c.labels))
+                .cloned()
+                .collect();
+            let mut folds: Vec<String> = style_clips
+                .iter()
+                .map(|c| c.labels.content.clone())
+                .collect();
+            folds.sort();
+            folds.dedup();
+            let (mut hits, mut n) = (0, 0);
+            for fold in &folds {
+                let (inside, outside): (Vec<Clip>, Vec<Clip>) = style_clips
+                    .iter()
+                    .cloned()
+                    .partition(|c| &c.labels.content == fold);
+                if outside.is_empty() {
+                    continue;
+                }
+                let classifier = ClipClassifier::train(
+                    &outside
+                        .iter()
+                        .map(|c| (c, c.labels.style.clone()))
+                        .collect::<Vec<_>>(),
+                    style_config(options),
+                )?;
+                for c in &inside {
+                    hits += (classifier.predict(&c.motion)? == c.labels.style) as usize;
+                    n += 1;
+                }
+            }
+            cv_style = Some(hits as f64 / n.max(1) as f64);
+        }
+        if cross_validate.content {
+            let mut folds: Vec<String> = train.iter().map(|c| c.labels.style.clone()).collect();
+            folds.sort();
+            folds.dedup();
+            let (mut hits, mut n) = (0, 0);
+            for fold in &folds {
+                let (inside, outside): (Vec<Clip>, Vec<Clip>) =
+                    train.iter().cloned().partition(|c| &c.labels.style == fold);
+                let classifier = ClipClassifier::train(
+                    &outside
+                        .iter()
+                        .map(|c| (c, c.labels.content.clone()))
+                        .collect::<Vec<_>>(),
+                    content_config(options),
+                )?;
+                for c in &inside {
+                    hits += (classifier.predict(&c.motion)? == c.labels.content) as usize;
+                    n += 1;
+                }
+            }
+            cv_content = Some(hits as f64 / n.max(1) as f64);
+        }
+        out.push(ClassifierCheck {
+            set,
+            held_out_style: style_hits as f64 / style_tests.len().max(1) as f64,
+            held_out_style_clips: style_tests.len(),
+            held_out_content: content_hits as f64 / test.len().max(1) as f64,
+            held_out_content_clips: test.len(),
+            cross_validated_style: cv_style,
+            cross_validated_content: cv_content,
+            style_errors,
+            content_errors,
+        });
+    }
+    Ok(out)
+}
+
+fn style_config(options: &EvalOptions) -> ClassifierConfig {
+    ClassifierConfig {
+        model: options.style_model,
+        descriptor: options.style_descriptor,
+        windows: options.style_windows,
+        trees: options.trees,
+        candidates: options.candidates,
+        mirror_training: options.style_mirror_training,
+        seed: options.seed,
+    }
+}
+
+fn content_config(options: &EvalOptions) -> ClassifierConfig {
+    ClassifierConfig {
+        model: options.content_model,
+        descriptor: options.content_descriptor,
+        windows: options.content_windows,
+        trees: options.trees,
+        candidates: options.candidates,
+        mirror_training: false,
+        seed: options.seed + 1,
+    }
+}
+
+/// The style classifier (trained on the clips `options.classifier_filter`
+/// accepts) and the content classifier (every clip) of a set.
+pub fn train_classifiers(
+    clips: &[Clip],
+    options: &EvalOptions,
+) -> Result<(ClipClassifier, ClipClassifier)> {
+    let style = ClipClassifier::train(
+        &clips
+            .iter()
+            .filter(|c| options.classifier_filter.accepts(&c.labels))
+            .map(|c| (c, c.labels.style.clone()))
+            .collect::<Vec<_>>(),
+        style_config(options),
+    )?;
+    let content = ClipClassifier::train(
+        &clips
+            .iter()
+            .map(|c| (c, c.labels.content.clone()))
+            .collect::<Vec<_>>(),
+        content_config(options),
+    )?;
+    Ok((style, content))
+}
+
 fn accepts(list: &[String], content: &str) -> bool {
     list.is_empty() || list.iter().any(|c| c == content)
 }
@@ -490,25 +551,7 @@ fn evaluate_set(
     }
     let classifier_clips = load_clips(&classifier_files)?;
     let test_clips = load_clips(&test_files)?;
-    let style_classifier = ClipClassifier::train(
-        &classifier_clips
-            .iter()
-            .filter(|c| options.classifier_filter.accepts(&c.labels))
-            .map(|c| (c, c.labels.style.clone()))
-            .collect::<Vec<_>>(),
-        options.style_descriptor,
-        options.trees,
-        options.seed,
-    )?;
-    let content_classifier = ClipClassifier::train(
-        &classifier_clips
-            .iter()
-            .map(|c| (c, c.labels.content.clone()))
-            .collect::<Vec<_>>(),
-        options.content_descriptor,
-        options.trees,
-        options.seed + 1,
-    )?;
+    let (style_classifier, content_classifier) = train_classifiers(&classifier_clips, options)?;
     let mut styles: Vec<String> = classifier_clips
         .iter()
         .map(|c| c.labels.style.clone())

@@ -33,6 +33,7 @@
 //! serialise to JSON.
 
 pub mod apply;
+pub mod classify;
 pub mod convert;
 pub mod data;
 pub mod eval;
