@@ -34,8 +34,12 @@ enum Command {
     Positions(commands::positions::Args),
     /// Multi-sensor capture: simulate, calibrate, fuse (offline or as a UDP server), write BVH, evaluate.
     Fuse(commands::fuse::Args),
+    /// Denoise a take (learned model or classical filter); train and evaluate denoisers.
+    Clean(Box<commands::clean::Args>),
     /// Motion retrieval by example: index a labelled library, query it, evaluate.
     Search(commands::search::Args),
+    /// Zero-shot style transfer from one example clip; train the autoencoder, evaluate.
+    Style(commands::style::Args),
     /// Play motions in a local web viewer (127.0.0.1).
     View(commands::view::ViewArgs),
     /// Draw motions as a filmstrip PNG or an animated GIF.
@@ -52,7 +56,9 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(args, &options),
         Command::Positions(args) => commands::positions::run(args, &options),
         Command::Fuse(args) => commands::fuse::run(args, &options),
+        Command::Clean(args) => commands::clean::run(*args, &options),
         Command::Search(args) => commands::search::run(args, &options),
+        Command::Style(args) => commands::style::run(args, &options),
         Command::View(args) => commands::view::view(args, &options),
         Command::Render(args) => commands::view::render(args, &options),
         Command::Demo(args) => commands::demo::run(args, &options),

@@ -1,12 +1,14 @@
 //! One module per subcommand: its arguments and a `run` that calls the
 //! libraries.
 
+pub mod clean;
 pub mod convert;
 pub mod demo;
 pub mod fuse;
 pub mod info;
 pub mod positions;
 pub mod search;
+pub mod style;
 pub mod view;
 
 use std::io::Write;

@@ -1,0 +1,336 @@
+//! `mocap clean`: denoise a take with the learned model or a classical filter,
+//! train a denoiser, evaluate methods (all in `mocap-clean`).
+//!
+//! `mocap clean IN -o OUT` cleans one take; `mocap clean train` and
+//! `mocap clean eval` are subcommands. A take literally named `train` or
+//! `eval` can be cleaned as `mocap clean ./train -o OUT`.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
+use mocap_clean::features::Representation;
+use mocap_clean::filters::Filter;
+use mocap_clean::infer::{clean_file, CleanOptions, Method};
+use mocap_clean::model::DenoiserConfig;
+use mocap_clean::training::{train, TrainOptions};
+use mocap_nn::device::DeviceChoice;
+
+use super::{write_output, GlobalOptions};
+
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct Args {
+    #[command(subcommand)]
+    command: Option<CleanCommand>,
+    #[command(flatten)]
+    take: TakeArgs,
+}
+
+#[derive(clap::Subcommand)]
+enum CleanCommand {
+    /// Train a denoiser on clean takes with synthetic markerless noise.
+    Train(TrainArgs),
+    /// Noisy input, tuned filters and models on held-out takes: rotation, position and acceleration errors.
+    Eval(EvalArgs),
+}
+
+/// `mocap clean IN -o OUT`.
+#[derive(clap::Args)]
+struct TakeArgs {
+    /// The take to clean (BVH).
+    #[arg(required = true)]
+    input: Option<PathBuf>,
+    /// The cleaned take (BVH: same skeleton and channel layout, root translation kept).
+    #[arg(long, short, required = true)]
+    output: Option<PathBuf>,
+    /// A model file written by `mocap clean train` (default: the model shipped with mocap).
+    #[arg(long, conflicts_with = "filter")]
+    model: Option<PathBuf>,
+    /// A classical filter instead of a model: butterworth:ORDER:HZ,
+    /// savitzky-golay:WINDOW:POLYORDER, median:WINDOW or one-euro:MIN_HZ:BETA:D_HZ.
+    #[arg(long, value_name = "SPEC")]
+    filter: Option<Filter>,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    /// Frames between window starts (default: a quarter window).
+    #[arg(long)]
+    hop: Option<usize>,
+    /// Print the report as JSON on standard output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct TrainArgs {
+    /// Folders or files of clean BVH takes (split by take into train / validation / test).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// The model file to write (safetensors).
+    #[arg(long, short)]
+    output: PathBuf,
+    #[arg(long)]
+    epochs: Option<usize>,
+    /// Training steps per epoch.
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Windows per step (report: 512).
+    #[arg(long)]
+    batch: Option<usize>,
+    /// Adam learning rate (report: 1e-3).
+    #[arg(long)]
+    lr: Option<f64>,
+    #[arg(long)]
+    seed: Option<u64>,
+    /// `derivative` (rotation + velocity + acceleration terms, alpha = dt^2, beta = dt^4) or `mse`.
+    #[arg(long, default_value = "derivative", value_parser = ["derivative", "mse"])]
+    loss: String,
+    /// rot6d, expmap or euler.
+    #[arg(long)]
+    representation: Option<Representation>,
+    /// The report's large network (for a GPU) instead of the small default.
+    #[arg(long)]
+    large: bool,
+    /// Channels of the first level.
+    #[arg(long)]
+    width: Option<usize>,
+    /// Times the network halves the time axis.
+    #[arg(long)]
+    levels: Option<usize>,
+    /// Residual blocks per level.
+    #[arg(long)]
+    blocks: Option<usize>,
+    /// Window length in frames (report: 16).
+    #[arg(long)]
+    window: Option<usize>,
+    /// Largest standard deviation of the random noise, degrees (report: 10).
+    #[arg(long)]
+    max_sigma: Option<f32>,
+    /// Probability that a training window gets spikes.
+    #[arg(long)]
+    spike_probability: Option<f32>,
+    /// At most this many simultaneous spikes (report: 3).
+    #[arg(long)]
+    max_spikes: Option<usize>,
+    /// Standard deviation of a spike's duration in frames (report: 16).
+    #[arg(long)]
+    spike_sigma: Option<f32>,
+    /// Train on at most this many takes (quick runs).
+    #[arg(long)]
+    max_train_takes: Option<usize>,
+    /// Folder of the resumable training state (default: OUTPUT.state).
+    #[arg(long)]
+    state: Option<PathBuf>,
+    /// Continue an interrupted run from its state folder.
+    #[arg(long)]
+    resume: bool,
+    /// Training and validation curves as PNG (default: OUTPUT with extension png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    /// Print the report as JSON on standard output.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct EvalArgs {
+    /// Folders or files of clean BVH takes.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// A model to compare, as LABEL=FILE or FILE (repeatable; the shipped model is always included
+    /// unless --no-default-model).
+    #[arg(long = "model", value_name = "[LABEL=]FILE")]
+    models: Vec<String>,
+    /// Leave out the shipped model.
+    #[arg(long)]
+    no_default_model: bool,
+    /// Leave out the classical filters.
+    #[arg(long)]
+    no_filters: bool,
+    /// Evaluate every take, not only the test split (for data the models were not trained on).
+    #[arg(long)]
+    all_takes: bool,
+    /// Evaluate at most this many takes.
+    #[arg(long)]
+    max_takes: Option<usize>,
+    /// Validation takes used to tune the filters.
+    #[arg(long)]
+    tune_takes: Option<usize>,
+    /// Spike lengths (frames) of the spike-survival study, comma separated; `none` to skip.
+    #[arg(long, value_name = "N,N,...")]
+    spike_lengths: Option<String>,
+    #[arg(long)]
+    seed: Option<u64>,
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    /// Also write the Markdown tables to this file.
+    #[arg(long)]
+    markdown: Option<PathBuf>,
+    /// Print the report as JSON (one entry per method and noise condition) instead of Markdown.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
+    match args.command {
+        Some(CleanCommand::Train(a)) => run_train(a, options),
+        Some(CleanCommand::Eval(a)) => run_eval(a),
+        None => run_clean(args.take, options),
+    }
+}
+
+fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    // clap enforces both (`required = true`); the options only exist so that
+    // the subcommands can go without them.
+    let (Some(input), Some(output)) = (a.input, a.output) else {
+        bail!("mocap clean needs a take and -o OUTPUT");
+    };
+    let method = match (a.model, a.filter) {
+        (Some(model), _) => Method::Model(model),
+        (None, Some(filter)) => Method::Filter(filter),
+        (None, None) => Method::DefaultModel,
+    };
+    let report = clean_file(&CleanOptions {
+        input,
+        output,
+        method,
+        device: a.device,
+        hop: a.hop,
+    })?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else if !options.quiet {
+        eprintln!(
+            "wrote {} ({} frames, {}, mean rotation change {:.2} degrees, {:.0} frames/s)",
+            report.output.display(),
+            report.frames,
+            report.method,
+            report.mean_change_deg,
+            report.frames_per_second
+        );
+    }
+    Ok(())
+}
+
+fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    let mut o = TrainOptions {
+        inputs: a.inputs,
+        out: a.output,
+        state_dir: a.state,
+        resume: a.resume,
+        plot: a.plot,
+        device: a.device,
+        max_train_takes: a.max_train_takes,
+        derivative_loss: a.loss == "derivative",
+        ..TrainOptions::default()
+    };
+    if a.large {
+        o.network = DenoiserConfig::large(0);
+    }
+    set(&mut o.epochs, a.epochs);
+    set(&mut o.steps_per_epoch, a.steps);
+    set(&mut o.batch_size, a.batch);
+    set(&mut o.learning_rate, a.lr);
+    set(&mut o.seed, a.seed);
+    set(&mut o.representation, a.representation);
+    set(&mut o.network.width, a.width);
+    set(&mut o.network.levels, a.levels);
+    set(&mut o.network.blocks, a.blocks);
+    set(&mut o.network.window, a.window);
+    set(&mut o.noise.spike_probability, a.spike_probability);
+    if let Some(random) = o.noise.random.as_mut() {
+        set(&mut random.max_sigma_deg, a.max_sigma);
+    }
+    if let Some(spikes) = o.noise.spikes.as_mut() {
+        set(&mut spikes.max_spikes, a.max_spikes);
+        set(&mut spikes.duration_sigma_frames, a.spike_sigma);
+    }
+    let report = train(&o)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else if !options.quiet {
+        let last = report.history.epochs.last();
+        eprintln!(
+            "trained {} epochs ({:.0} samples/s); validation MSE {:.6}; wrote {} and {}",
+            report.history.epochs.len(),
+            report.samples_per_second,
+            last.map_or(f64::NAN, |e| e.valid_loss),
+            report.model.display(),
+            report.plot.display()
+        );
+    }
+    Ok(())
+}
+
+fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
+    let mut o = EvalOptions {
+        inputs: a.inputs,
+        test_split_only: !a.all_takes,
+        filters: !a.no_filters,
+        max_takes: a.max_takes,
+        device: a.device,
+        ..EvalOptions::default()
+    };
+    if a.no_default_model {
+        o.models.retain(|m| m.path.is_some());
+    }
+    for text in &a.models {
+        let (label, path) = text.split_once('=').unwrap_or((text, text));
+        if path.is_empty() {
+            bail!("--model {text:?}: expected LABEL=FILE or FILE");
+        }
+        o.models.push(ModelEntry {
+            label: label.into(),
+            path: Some(PathBuf::from(path)),
+        });
+    }
+    set(&mut o.tune_takes, a.tune_takes);
+    set(&mut o.seed, a.seed);
+    if let Some(text) = &a.spike_lengths {
+        o.spike_lengths = parse_lengths(text)?;
+    }
+    if o.models.is_empty() && !o.filters {
+        bail!("nothing to evaluate: --no-default-model and --no-filters with no --model");
+    }
+    let report = evaluate(&o)?;
+    let markdown = report.to_markdown();
+    if let Some(path) = &a.markdown {
+        write_output(Some(path), |w| w.write_all(markdown.as_bytes()))?;
+    }
+    let text = if a.json {
+        serde_json::to_string_pretty(&report)? + "\n"
+    } else {
+        markdown
+    };
+    write_output(None, |w| w.write_all(text.as_bytes()))
+}
+
+/// `2,4,8` or `none`.
+fn parse_lengths(text: &str) -> anyhow::Result<Vec<usize>> {
+    if text.trim() == "none" {
+        return Ok(Vec::new());
+    }
+    text.split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| {
+            let n: usize = s.trim().parse().with_context(|| {
+                format!("--spike-lengths {text:?}: expected frame counts like 2,4,8 or none")
+            })?;
+            if n == 0 {
+                bail!("--spike-lengths {text:?}: a spike lasts at least one frame");
+            }
+            Ok(n)
+        })
+        .collect()
+}
+
+/// Overrides a default when the option was given.
+fn set<T>(slot: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *slot = v;
+    }
+}

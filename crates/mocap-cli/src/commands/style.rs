@@ -1,0 +1,267 @@
+//! `mocap style`: zero-shot style transfer with elastic patches: train the
+//! autoencoder once, apply a style clip, evaluate (all in `mocap-style`).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use mocap_nn::device::DeviceChoice;
+use mocap_style::apply::{apply, parse_blend, ApplyOptions};
+use mocap_style::convert::Method;
+use mocap_style::eval::{evaluate, EvalOptions};
+use mocap_style::train::{train, TrainOptions};
+
+use super::{write_output, GlobalOptions};
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    command: StyleCommand,
+}
+
+#[derive(clap::Subcommand)]
+enum StyleCommand {
+    /// Train the motion autoencoder on many styles (once; no training per style).
+    Train(TrainArgs),
+    /// Give SOURCE the style (and timing) of one example clip.
+    Apply(ApplyArgs),
+    /// Style/content accuracy, timing, foot skating and smoothness of every method on held-out takes.
+    Eval(EvalArgs),
+}
+
+#[derive(clap::Args)]
+struct TrainArgs {
+    /// Folders or files of BVH clips named `<set>_<content>_<style>_<take>.bvh`.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// The model file to write (safetensors).
+    #[arg(long, short)]
+    output: PathBuf,
+    /// Train on these contents only (comma separated; default: walking contents).
+    #[arg(long, value_delimiter = ',')]
+    contents: Vec<String>,
+    #[arg(long)]
+    epochs: Option<usize>,
+    #[arg(long)]
+    steps: Option<usize>,
+    #[arg(long)]
+    batch: Option<usize>,
+    /// Window length in frames.
+    #[arg(long)]
+    window: Option<usize>,
+    #[arg(long)]
+    lr: Option<f64>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Do not add mirrored copies of the clips.
+    #[arg(long)]
+    no_mirror: bool,
+    /// Train on every clip (no held-out evaluation takes).
+    #[arg(long)]
+    no_hold_out: bool,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    /// Loss curve PNG.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Continue from the last checkpoint of an interrupted run.
+    #[arg(long)]
+    resume: bool,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct ApplyArgs {
+    /// The motion to restyle (BVH).
+    source: PathBuf,
+    /// One example clip of the style (BVH, same rig as the source).
+    #[arg(long)]
+    style: PathBuf,
+    /// The restyled motion (BVH, the source's skeleton).
+    #[arg(long, short)]
+    output: PathBuf,
+    /// The autoencoder (default: the model shipped with mocap).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// 1: full style, 0: the source.
+    #[arg(long, default_value_t = 1.0)]
+    strength: f32,
+    /// Fixed patches instead of elastic ones (the style's timing is not carried over).
+    #[arg(long)]
+    no_elastic: bool,
+    /// elastic-patches, fixed-patches, whitening-colouring or adain.
+    #[arg(long, conflicts_with = "no_elastic")]
+    method: Option<Method>,
+    /// Let the style fade in over this time, e.g. `2s` or `1.5`.
+    #[arg(long, value_name = "SECONDS")]
+    fade_in: Option<String>,
+    /// Blend with a second style: OTHER_STYLE_CLIP:WEIGHT.
+    #[arg(long, value_name = "CLIP:WEIGHT")]
+    blend: Option<String>,
+    /// Patch length in frames.
+    #[arg(long)]
+    patch: Option<usize>,
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+struct EvalArgs {
+    /// Folders or files of labelled clips (`<set>_<content>_<style>_<take>.bvh`).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// The autoencoder (default: the shipped model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Contents of the source clips (comma separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    sources: Vec<String>,
+    /// Contents of the style clips (comma separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    styles: Vec<String>,
+    /// Methods to compare (comma separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<Method>,
+    /// Contents the style classifier trains on (comma separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    classifier_contents: Vec<String>,
+    /// Patch length in frames.
+    #[arg(long)]
+    patch: Option<usize>,
+    /// Trees of each classifier's forest.
+    #[arg(long, default_value_t = 100)]
+    trees: usize,
+    /// Write side-by-side filmstrips (source, style, output) here.
+    #[arg(long)]
+    filmstrips: Option<PathBuf>,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
+    #[arg(long, default_value = "cpu")]
+    device: DeviceChoice,
+    /// Also write the Markdown tables to this file.
+    #[arg(long)]
+    markdown: Option<PathBuf>,
+    /// Print the report as JSON (every pair and method) instead of Markdown.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `2s`, `1.5s` or `1.5` seconds.
+fn parse_seconds(text: &str) -> anyhow::Result<f64> {
+    let number = text.trim().trim_end_matches('s');
+    let seconds: f64 = number
+        .parse()
+        .with_context(|| format!("--fade-in {text:?}: expected seconds, e.g. 2s"))?;
+    if !(seconds.is_finite() && seconds >= 0.0) {
+        bail!("--fade-in {text:?}: expected a duration of zero seconds or more");
+    }
+    Ok(seconds)
+}
+
+pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
+    match args.command {
+        StyleCommand::Train(a) => {
+            let defaults = TrainOptions::default();
+            let mut train_options = TrainOptions {
+                inputs: a.inputs,
+                out: a.output,
+                hold_out: !a.no_hold_out,
+                mirror: !a.no_mirror,
+                window: a.window.unwrap_or(defaults.window),
+                batch_size: a.batch.unwrap_or(defaults.batch_size),
+                learning_rate: a.lr.unwrap_or(defaults.learning_rate),
+                epochs: a.epochs.unwrap_or(defaults.epochs),
+                steps_per_epoch: a.steps.unwrap_or(defaults.steps_per_epoch),
+                seed: a.seed,
+                device: a.device,
+                plot: a.plot,
+                resume: a.resume,
+                ..defaults
+            };
+            if !a.contents.is_empty() {
+                train_options.filter.contents = a.contents;
+            }
+            let report = train(&train_options)?;
+            if a.json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else if !options.quiet {
+                let last = report.history.epochs.last();
+                eprintln!(
+                    "trained {} epochs ({:.0} windows/s); validation MSE {:.4}; wrote {} and {}",
+                    report.history.epochs.len(),
+                    report.samples_per_second,
+                    last.map_or(f64::NAN, |e| e.valid_loss),
+                    report.model.display(),
+                    report.plot.display()
+                );
+            }
+        }
+        StyleCommand::Apply(a) => {
+            let mut apply_options = ApplyOptions::new(&a.source, &a.style, &a.output);
+            apply_options.model = a.model;
+            apply_options.strength = a.strength;
+            apply_options.method = match (a.method, a.no_elastic) {
+                (Some(m), _) => m,
+                (None, true) => Method::FixedPatches,
+                (None, false) => Method::ElasticPatches,
+            };
+            if let Some(text) = &a.fade_in {
+                apply_options.fade_in_seconds = parse_seconds(text)?;
+            }
+            if let Some(text) = &a.blend {
+                apply_options.blend = Some(parse_blend(text)?);
+            }
+            if let Some(patch) = a.patch {
+                apply_options.patch = patch;
+            }
+            apply_options.device = a.device;
+            let report = apply(&apply_options)?;
+            if a.json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else if !options.quiet {
+                eprintln!(
+                    "wrote {} ({} frames from {}; time scale {:.2})",
+                    report.out.display(),
+                    report.output_frames,
+                    report.source_frames,
+                    report.time_scale
+                );
+            }
+        }
+        StyleCommand::Eval(a) => {
+            let mut eval_options = EvalOptions {
+                inputs: a.inputs,
+                model: a.model,
+                source_contents: a.sources,
+                style_contents: a.styles,
+                trees: a.trees,
+                filmstrips: a.filmstrips,
+                device: a.device,
+                ..EvalOptions::default()
+            };
+            if !a.methods.is_empty() {
+                eval_options.methods = a.methods;
+            }
+            if !a.classifier_contents.is_empty() {
+                eval_options.classifier_filter.contents = a.classifier_contents;
+            }
+            if let Some(patch) = a.patch {
+                eval_options.convert.patch = patch;
+            }
+            let report = evaluate(&eval_options)?;
+            let markdown = report.to_markdown();
+            if let Some(path) = &a.markdown {
+                write_output(Some(path), |w| w.write_all(markdown.as_bytes()))?;
+            }
+            let text = if a.json {
+                serde_json::to_string_pretty(&report)? + "\n"
+            } else {
+                markdown
+            };
+            write_output(None, |w| w.write_all(text.as_bytes()))?;
+        }
+    }
+    Ok(())
+}

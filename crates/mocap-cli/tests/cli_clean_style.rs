@@ -1,0 +1,219 @@
+//! `mocap clean` and `mocap style` end to end on the bundled takes (and, for
+//! training, a few real Bandai takes when `../shared/data` is present).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use mocap_core::io::bvh::read_bvh;
+
+fn mocap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args(args)
+        .output()
+        .expect("the mocap binary runs")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn sample(name: &str) -> String {
+    mocap_testdata::sample(name).display().to_string()
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+/// Mean absolute difference of the rotation channels of two takes with the
+/// same layout, in degrees.
+fn mean_channel_change(a: &Path, b: &Path) -> f32 {
+    let a = read_bvh(a).unwrap();
+    let b = read_bvh(b).unwrap();
+    let (sum, n) = a
+        .values()
+        .iter()
+        .zip(b.values())
+        .fold((0.0f32, 0usize), |(s, n), (x, y)| {
+            (s + (x - y).abs(), n + 1)
+        });
+    sum / n as f32
+}
+
+#[test]
+fn clean_with_the_shipped_model_keeps_the_layout_and_changes_the_rotations() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let output = dir.path().join("clean.bvh");
+    let out = mocap(&["clean", &input, "-o", path(&output), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let original = read_bvh(Path::new(&input)).unwrap();
+    let cleaned = read_bvh(&output).unwrap();
+    assert_eq!(report["frames"], original.frame_count());
+    assert_eq!(cleaned.frame_count(), original.frame_count());
+    assert_eq!(
+        cleaned.skeleton().joints().len(),
+        original.skeleton().joints().len()
+    );
+    assert_eq!(cleaned.values().len(), original.values().len());
+    // The model changes a clean take only a little, but it does change it.
+    let change = mean_channel_change(Path::new(&input), &output);
+    assert!(
+        change > 0.01 && change < 20.0,
+        "mean change {change} degrees"
+    );
+}
+
+#[test]
+fn clean_with_a_filter_and_bad_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let output = dir.path().join("filtered.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--filter",
+        "butterworth:2:3",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(mean_channel_change(Path::new(&input), &output) > 0.01);
+
+    // A filter spec that does not parse is a usage error (2).
+    let out = mocap(&["clean", &input, "-o", path(&output), "--filter", "gauss:3"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+
+    // A missing take is an input error (1) naming the file, and nothing is written.
+    let missing = dir.path().join("missing.bvh");
+    let never = dir.path().join("never.bvh");
+    let out = mocap(&["clean", path(&missing), "-o", path(&never)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("missing.bvh"), "{}", stderr(&out));
+    assert!(!never.exists());
+
+    // Without -o it is a usage error.
+    let out = mocap(&["clean", &input]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn clean_train_writes_a_model_that_clean_can_use() {
+    let Some(data) = mocap_testdata::shared_data() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // Forty real takes: the 10% validation split by take gets several.
+    let takes = dir.path().join("takes");
+    std::fs::create_dir(&takes).unwrap();
+    let files: Vec<PathBuf> = mocap_testdata::bvh_files(&data.join("bandai/dataset-2"));
+    for file in files.iter().step_by(files.len() / 40).take(40) {
+        std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
+    }
+    let model = dir.path().join("tiny.safetensors");
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "-o",
+        path(&model),
+        "--epochs",
+        "2",
+        "--steps",
+        "2",
+        "--batch",
+        "8",
+        "--width",
+        "8",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["history"]["epochs"].as_array().unwrap().len(), 2);
+    assert!(model.is_file());
+    assert!(model.with_extension("png").is_file());
+
+    let output = dir.path().join("clean.bvh");
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--model",
+        path(&model),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(output.is_file());
+}
+
+#[test]
+fn style_apply_restyles_the_bundled_walk() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = sample("dataset-1_walk_normal_001.bvh");
+    let style = sample("dataset-1_walk_proud_001.bvh");
+    let output = dir.path().join("proud.bvh");
+    let out = mocap(&[
+        "style",
+        "apply",
+        &source,
+        "--style",
+        &style,
+        "-o",
+        path(&output),
+        "--strength",
+        "0.8",
+        "--fade-in",
+        "1s",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let restyled = read_bvh(&output).unwrap();
+    let original = read_bvh(Path::new(&source)).unwrap();
+    assert_eq!(
+        report["output_frames"].as_u64().unwrap() as usize,
+        restyled.frame_count()
+    );
+    // The output keeps the source's skeleton.
+    assert_eq!(
+        restyled.skeleton().joints().len(),
+        original.skeleton().joints().len()
+    );
+    // Elastic source patches are 0.75 P to 1.25 P frames long and become P
+    // frames, so the duration changes by a factor within [1/1.25, 1/0.75].
+    let scale = report["time_scale"].as_f64().unwrap();
+    assert!(
+        (0.8 - 1e-9..=1.0 / 0.75 + 1e-9).contains(&scale),
+        "time scale {scale}"
+    );
+
+    // A bad duration and a missing style clip are input errors (1).
+    let out = mocap(&[
+        "style",
+        "apply",
+        &source,
+        "--style",
+        &style,
+        "-o",
+        path(&output),
+        "--fade-in",
+        "soon",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("--fade-in"), "{}", stderr(&out));
+    let out = mocap(&[
+        "style",
+        "apply",
+        &source,
+        "--style",
+        path(&dir.path().join("nope.bvh")),
+        "-o",
+        path(&dir.path().join("x.bvh")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("nope.bvh"), "{}", stderr(&out));
+    assert!(!dir.path().join("x.bvh").exists());
+}
