@@ -17,7 +17,8 @@
 //!   Savitzky-Golay, median, One Euro);
 //! - [`dataset`]: BVH takes split by take, windows;
 //! - [`model`]: the autoencoder and its configuration;
-//! - [`loss`]: the derivative loss;
+//! - [`loss`]: the derivative loss and the optional position term;
+//! - [`fk`]: forward kinematics of 6D features in burn tensors (position term);
 //! - [`training`]: training with checkpoints, resume and curves;
 //! - [`infer`]: cleaning whole takes with blended overlapping windows;
 //! - [`eval`]: the evaluation of every method on held-out takes.
