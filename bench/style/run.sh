@@ -7,6 +7,7 @@
 #   bash bench/style/run.sh --classifiers  # also compare the evaluation's classifiers
 #                                          # on real clips (held out + cross-validation)
 #   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
+#   bash bench/style/run.sh --contacts # also patches with foot-contact cleanup (opt-in)
 # (flags combine)
 #
 # Build profile: `--profile test` (dependencies at opt-level 2 from the dev
@@ -69,4 +70,12 @@ if flag --patches; then
       --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-p$P.json" \
       --markdown "$OUT/eval-p$P.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
   done
+fi
+
+if flag --contacts; then
+  # Foot-contact cleanup (two-bone IK pinning the ankles on the ground),
+  # off by default: its trade-off is measured here.
+  "$BIN/eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-contacts.json" \
+    --markdown "$OUT/eval-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 fi

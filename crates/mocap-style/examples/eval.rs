@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release -p mocap-style --example eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
-//!     [--classifier-contents walk,walk-back] [--patch 32] [--filmstrips DIR] \
+//!     [--classifier-contents walk,walk-back] [--patch 32] [--foot-contacts] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...
 //! ```
 
@@ -29,6 +29,7 @@ fn main() {
             "--sources" => options.source_contents = list(value()),
             "--styles" => options.style_contents = list(value()),
             "--classifier-contents" => options.classifier_filter.contents = list(value()),
+            "--foot-contacts" => options.convert.foot_contacts = true,
             "--patch" => options.convert.patch = value().parse().expect("--patch N"),
             "--style-descriptor" => {
                 options.style_descriptor = serde_json::from_value(serde_json::json!(value()))

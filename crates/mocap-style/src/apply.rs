@@ -23,6 +23,7 @@ use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
+use crate::contact::{clean_foot_contacts, ContactOptions};
 use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, StyleInput};
 use crate::data::mirrored;
 use crate::features::{compose, decompose, sample_frames, RootTrack};
@@ -215,7 +216,10 @@ pub fn restyle(
 
     let t = Instant::now();
     let out_rotations = model.description.normalization.rotations(&decoded);
-    let motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
+    let mut motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
+    if options.foot_contacts {
+        clean_foot_contacts(&mut motion, rig, &ContactOptions::default());
+    }
     let motion = if (motion.fps() - source.fps()).abs() > 1e-3 * source.fps() {
         resample_fps(&motion, source.fps())?
     } else {

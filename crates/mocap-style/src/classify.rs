@@ -173,7 +173,7 @@ const BANDS: [(f64, f64); 5] = [(0.3, 0.9), (0.9, 1.5), (1.5, 2.5), (2.5, 4.0), 
 
 /// The gait descriptor of a window (frame rate `fps`):
 ///
-/// - mean and deviation of every feature (posture, as [`statistics_row`]);
+/// - mean and deviation of every feature (posture);
 /// - mean absolute rate of change of every feature, per second (how briskly
 ///   each part moves: a tired walk and an active one hold similar poses at
 ///   different speeds);
@@ -183,7 +183,9 @@ const BANDS: [(f64, f64); 5] = [(0.3, 0.9), (0.9, 1.5), (1.5, 2.5), (2.5, 4.0), 
 /// - the step period (lag of the strongest autocorrelation of the distance
 ///   between the ankles, 0.25-1.25 s) and that autocorrelation (how regular
 ///   the steps are);
-/// - the power of [`SPECTRUM_SIGNALS`] in [`BANDS`] (Hann-windowed discrete
+/// - the power of 12 swinging signals (head and pelvis bob, arm swing, trunk
+///   sway, knee and elbow flexion, the legs' alternation) in 5 bands of
+///   0.3-8 Hz (Hann-windowed discrete
 ///   Fourier transform), as a share of the signal's power so that it says
 ///   rhythm, not amplitude (the deviation already says amplitude).
 pub fn gait_row(w: &FeatureSequence, fps: f64) -> Vec<f32> {

@@ -176,6 +176,10 @@ pub struct ConvertOptions {
     pub strength: f32,
     /// Frames over which the strength rises from 0 (0: no fade).
     pub fade_in_frames: f32,
+    /// Pin the feet during ground contacts after decoding
+    /// ([`crate::contact`]); applied by [`crate::apply::restyle`].
+    #[serde(default)]
+    pub foot_contacts: bool,
 }
 
 impl Default for ConvertOptions {
@@ -187,6 +191,7 @@ impl Default for ConvertOptions {
             stretch_step: 4,
             strength: 1.0,
             fade_in_frames: 0.0,
+            foot_contacts: false,
         }
     }
 }

@@ -24,8 +24,11 @@
 //!    of patches offset by half a patch is blended in linearly so there are
 //!    no seams. Strength, fade-in and a blend of two styles are latent
 //!    interpolations.
+//!    [`contact`] can pin the feet during ground contacts afterwards
+//!    (opt-in).
 //! 4. [`apply`]: the whole thing on files (`mocap style apply`); [`eval`]
-//!    measures it on labelled clips (`mocap style eval`); [`filmstrip`]
+//!    measures it on labelled clips (`mocap style eval`) with independent
+//!    classifiers ([`classify`]); [`filmstrip`]
 //!    draws source, style and output side by side.
 //!
 //! The command line is a thin layer over [`train::TrainOptions`],
@@ -34,6 +37,7 @@
 
 pub mod apply;
 pub mod classify;
+pub mod contact;
 pub mod convert;
 pub mod data;
 pub mod eval;
