@@ -9,7 +9,9 @@
 //! Options: `--labels-from-name PATTERN` or `--labels FILE`; `--folds K`
 //! (default 5) or `--by-performer` or `--test DIR` (the positional folders
 //! are then the training clips); `--trees T`, `--candidates K`,
-//! `--min-entropy E`, `--frames N`, `--seed S`; `--no-baselines`,
+//! `--min-entropy E`, `--frames N`, `--seed S`; `--min-clips-for-average M`
+//! (the second macro average, over classes with at least M clips; default
+//! 10); `--no-baselines`,
 //! `--no-unseen`, `--no-takes`; `--name NAME` (the data's name in the
 //! report); `--json`; `--out FILE` writes the report there too (atomically).
 
@@ -73,6 +75,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--frames" => config.index.frames = value(&mut args, &arg)?.parse()?,
             "--seed" => config.seed = value(&mut args, &arg)?.parse()?,
+            "--min-clips-for-average" => {
+                config.min_clips_for_average = value(&mut args, &arg)?.parse()?
+            }
             "--no-bootstrap" => config.index.forest.bootstrap = false,
             "--no-baselines" => config.baselines = false,
             "--no-unseen" => config.unseen_classes = false,

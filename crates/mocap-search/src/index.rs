@@ -21,8 +21,17 @@
 //! file from another format or feature version gets a clear "stale, rebuild
 //! it" message rather than a decoding error, and the checksum catches a
 //! truncated or damaged file before any of it is trusted.
+//!
+//! # Clip paths
+//!
+//! The file stores each library clip's path relative to the folder the
+//! index file is in (absolute where no relative path exists), and
+//! [`Index::load`] turns them back into absolute paths; so an index and its
+//! clips can be moved together, and queries name the right files whatever
+//! the working directory. (Format version 1 stored the paths as given on the
+//! command line, which broke when the working directory changed.)
 
-use std::path::Path;
+use std::path::{Component, Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -35,7 +44,7 @@ use crate::intervals::{FeatureSequence, IntervalLayout};
 
 const MAGIC: &[u8; 8] = b"MOCAPIDX";
 /// Version of the index file layout; change it when `Index` changes.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 const HEADER_LEN: usize = 28;
 
 /// How to build an index.
@@ -58,7 +67,9 @@ impl Default for IndexConfig {
 /// One clip of the library as stored in the index.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LibraryClip {
-    /// The path the clip was read from, as given when the index was built.
+    /// The file the clip was read from: as given when the index was built,
+    /// in the file relative to the index's folder (see the module docs),
+    /// absolute after [`Index::load`].
     pub path: String,
     /// Index into [`Index::classes`].
     pub label: u32,
@@ -428,7 +439,14 @@ impl Index {
 
     /// Writes the index atomically (see the module docs for the layout).
     pub fn save(&self, path: &Path) -> Result<()> {
-        let payload = postcard::to_stdvec(self)
+        let folder = absolute(&index_folder(path));
+        let mut stored = self.clone();
+        for clip in &mut stored.clips {
+            let clip_path = absolute(Path::new(&clip.path));
+            let relative = relative_to(&clip_path, &folder).unwrap_or(clip_path);
+            clip.path = relative.to_string_lossy().into_owned();
+        }
+        let payload = postcard::to_stdvec(&stored)
             .map_err(|e| SearchError::Invalid(format!("cannot serialise the index: {e}")))?;
         let mut header = Vec::with_capacity(HEADER_LEN);
         header.extend_from_slice(MAGIC);
@@ -450,10 +468,21 @@ impl Index {
             path: path.to_path_buf(),
             source: e,
         })?;
-        Index::from_bytes(&bytes, path)
+        let mut index = Index::from_bytes(&bytes, path)?;
+        let folder = absolute(&index_folder(path));
+        for clip in &mut index.clips {
+            let stored = Path::new(&clip.path);
+            if stored.is_relative() {
+                clip.path = lexical_clean(&folder.join(stored))
+                    .to_string_lossy()
+                    .into_owned();
+            }
+        }
+        Ok(index)
     }
 
-    /// Decodes index file contents; `path` names the file in errors.
+    /// Decodes index file contents; `path` names the file in errors. Clip
+    /// paths stay as stored (relative to the index file's folder).
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Index> {
         let bad = |message: String| SearchError::BadIndex {
             path: path.to_path_buf(),
@@ -555,4 +584,100 @@ pub fn nearest(distances: &[f32], top: usize) -> Vec<usize> {
     }
     order.sort_by(by);
     order
+}
+
+/// The folder an index file is in (`.` for a bare file name).
+fn index_folder(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// `path` made absolute: the canonical path where it exists (symbolic links
+/// resolved, so that `..` in a relative path means what the file system
+/// says), else joined to the working directory and cleaned lexically.
+fn absolute(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let joined = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .map(|d| d.join(path))
+            .unwrap_or_else(|_| path.to_path_buf())
+    };
+    lexical_clean(&joined)
+}
+
+/// Drops `.` components and folds `name/..` pairs, without touching the
+/// file system.
+fn lexical_clean(path: &Path) -> PathBuf {
+    let mut out: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => match out.last() {
+                Some(Component::Normal(_)) => {
+                    out.pop();
+                }
+                Some(Component::RootDir) | Some(Component::Prefix(_)) => {}
+                _ => out.push(c),
+            },
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
+}
+
+/// `path` relative to the folder `base` (both absolute and clean), or
+/// `None` where they share no root (other drives on Windows).
+fn relative_to(path: &Path, base: &Path) -> Option<PathBuf> {
+    let p: Vec<Component> = path.components().collect();
+    let b: Vec<Component> = base.components().collect();
+    if p.first() != b.first() {
+        return None;
+    }
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod path_tests {
+    use super::*;
+
+    #[test]
+    fn relative_paths_go_up_and_down_from_the_index_folder() {
+        let rel = relative_to(
+            Path::new("/work/shared/data/a.bvh"),
+            Path::new("/work/main/models"),
+        );
+        assert_eq!(rel, Some(PathBuf::from("../../shared/data/a.bvh")));
+        let rel = relative_to(
+            Path::new("/work/main/models/a.bvh"),
+            Path::new("/work/main/models"),
+        );
+        assert_eq!(rel, Some(PathBuf::from("a.bvh")));
+        // And back: the index folder joined with the stored path.
+        let back = lexical_clean(&Path::new("/work/main/models").join("../../shared/data/a.bvh"));
+        assert_eq!(back, PathBuf::from("/work/shared/data/a.bvh"));
+    }
+
+    #[test]
+    fn lexical_clean_folds_dots() {
+        assert_eq!(lexical_clean(Path::new("a/./b/../c")), PathBuf::from("a/c"));
+        assert_eq!(lexical_clean(Path::new("../a/..")), PathBuf::from(".."));
+        assert_eq!(lexical_clean(Path::new("/..")), PathBuf::from("/"));
+    }
 }
