@@ -36,7 +36,7 @@ pub const DEFAULT_MODEL_PATH: &str = concat!(
 );
 
 /// The shipped default model's bytes, compiled in.
-static DEFAULT_MODEL: &[u8] = include_bytes!("../../../models/clean-default.safetensors");
+pub static DEFAULT_MODEL: &[u8] = include_bytes!("../../../models/clean-default.safetensors");
 
 /// A trained denoiser ready to clean takes.
 pub struct CleanModel {
@@ -71,9 +71,11 @@ impl CleanModel {
         if let Some(path) = std::env::var_os("MOCAP_CLEAN_MODEL") {
             return Self::load(Path::new(&path), device);
         }
+        // Named as the style crate names its built-in model: the build
+        // machine's source path means nothing where the binary runs.
         Self::from_bytes(
             DEFAULT_MODEL.to_vec(),
-            Path::new(DEFAULT_MODEL_PATH),
+            Path::new("<built-in models/clean-default.safetensors>"),
             device,
         )
     }

@@ -40,15 +40,80 @@ use serde::{Deserialize, Serialize};
 /// there when the demo is not run from the repository root.
 const WORKSPACE_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
+/// The bundled files, compiled into the binary so that an installed `mocap`
+/// (no source tree beside it) still runs the demo. The two models are the
+/// same bytes the libraries load by default.
+const EMBEDDED: &[(&str, &[u8])] = &[
+    (
+        "samples/dataset-1_walk_normal_001.bvh",
+        include_bytes!("../../../samples/dataset-1_walk_normal_001.bvh"),
+    ),
+    (
+        "samples/dataset-1_walk_proud_001.bvh",
+        include_bytes!("../../../samples/dataset-1_walk_proud_001.bvh"),
+    ),
+    (
+        "models/search-bandai-content.idx",
+        include_bytes!("../../../models/search-bandai-content.idx"),
+    ),
+    (
+        "models/clean-default.safetensors",
+        mocap_clean::infer::DEFAULT_MODEL,
+    ),
+    (
+        "models/style-default.safetensors",
+        mocap_style::train::DEFAULT_MODEL,
+    ),
+];
+
 /// A bundled file (`samples/...`, `models/...`): relative to the current
 /// folder when it is there (shorter paths in the viewer commands), else in
-/// the source tree the binary was built from.
+/// the source tree the binary was built from, else the copy compiled into
+/// the binary, written once to `<temp>/mocap-<version>/`.
 pub fn bundled(relative: &str) -> PathBuf {
-    let here = PathBuf::from(relative);
-    if here.exists() {
-        return here;
+    let cache = std::env::temp_dir().join(concat!("mocap-", env!("CARGO_PKG_VERSION")));
+    bundled_from(
+        relative,
+        &[Path::new("."), Path::new(WORKSPACE_ROOT)],
+        &cache,
+    )
+}
+
+/// [`bundled`] with explicit places to look and a cache folder. When a file
+/// is found nowhere and cannot be written to the cache either, the
+/// source-tree path is returned so that the stage reports it as missing.
+fn bundled_from(relative: &str, roots: &[&Path], cache: &Path) -> PathBuf {
+    for root in roots {
+        let candidate = if *root == Path::new(".") {
+            PathBuf::from(relative)
+        } else {
+            root.join(relative)
+        };
+        if candidate.is_file() {
+            return candidate;
+        }
     }
-    Path::new(WORKSPACE_ROOT).join(relative)
+    let fallback = roots
+        .last()
+        .map_or_else(|| PathBuf::from(relative), |r| r.join(relative));
+    let Some((_, bytes)) = EMBEDDED.iter().find(|(name, _)| *name == relative) else {
+        return fallback;
+    };
+    let copy = cache.join(relative);
+    // An earlier run's copy is reused only when it is complete and current.
+    if std::fs::read(&copy).is_ok_and(|existing| existing == *bytes) {
+        return copy;
+    }
+    let written = copy
+        .parent()
+        .map_or(Ok(()), std::fs::create_dir_all)
+        .is_ok()
+        && mocap_core::io::atomic::write_bytes_atomically(&copy, bytes).is_ok();
+    if written {
+        copy
+    } else {
+        fallback
+    }
 }
 
 /// What the demo runs on and where it writes.
@@ -449,4 +514,48 @@ pub(crate) fn units_per_metre(motion: &mocap_core::Motion) -> f32 {
         high = high.max(y);
     }
     mocap_fuse::sim::guess_units_per_metre(high - low)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundled_files_come_from_the_binary_when_no_source_tree_is_there() {
+        let nowhere = tempfile::tempdir().unwrap();
+        let cache = tempfile::tempdir().unwrap();
+        let absent_root = nowhere.path().join("no-repository");
+        for (relative, bytes) in EMBEDDED {
+            let path = bundled_from(relative, &[absent_root.as_path()], cache.path());
+            assert!(path.starts_with(cache.path()), "{}", path.display());
+            assert_eq!(std::fs::read(&path).unwrap(), *bytes);
+            // A second call reuses the copy.
+            assert_eq!(
+                bundled_from(relative, &[absent_root.as_path()], cache.path()),
+                path
+            );
+        }
+        // The embedded sample is the real take.
+        let sample = bundled_from(
+            "samples/dataset-1_walk_normal_001.bvh",
+            &[absent_root.as_path()],
+            cache.path(),
+        );
+        let motion = mocap_core::io::bvh::read_bvh(&sample).unwrap();
+        assert_eq!(motion.skeleton().joints().len(), 22);
+        // A file that is not bundled stays missing.
+        let unknown = bundled_from("models/unknown.idx", &[absent_root.as_path()], cache.path());
+        assert!(!unknown.exists());
+    }
+
+    #[test]
+    fn the_source_tree_comes_first() {
+        let cache = tempfile::tempdir().unwrap();
+        let path = bundled_from(
+            "samples/dataset-1_walk_normal_001.bvh",
+            &[Path::new(WORKSPACE_ROOT)],
+            cache.path(),
+        );
+        assert!(path.starts_with(WORKSPACE_ROOT));
+    }
 }
