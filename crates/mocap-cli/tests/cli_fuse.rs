@@ -380,6 +380,7 @@ fn eval_on_ntu_files_without_ground_truth() {
 
 #[test]
 fn eval_on_a_bvh_take_compares_methods_with_the_truth() {
+    let plots = tempfile::tempdir().unwrap();
     let out = mocap(&[
         "fuse",
         "eval",
@@ -390,9 +391,33 @@ fn eval_on_a_bvh_take_compares_methods_with_the_truth() {
         "1",
         "--json",
         "-",
+        "--plots",
+        plots.path().to_str().unwrap(),
     ]);
     let report = json(&out);
     let results = report["results"].as_array().unwrap();
+    // Per-joint errors average to the method's MPJPE, and are drawn.
+    for r in results {
+        let per_joint: Vec<f64> = r["per_joint_mm"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(per_joint.len(), 25);
+        let mean = per_joint.iter().sum::<f64>() / 25.0;
+        assert!((mean - r["mpjpe_mm"].as_f64().unwrap()).abs() < 1e-6);
+    }
+    for extension in ["png", "svg"] {
+        let plot = plots
+            .path()
+            .join(format!("per-joint-3-sensors.{extension}"));
+        assert!(
+            std::fs::metadata(&plot).unwrap().len() > 1000,
+            "{}",
+            plot.display()
+        );
+    }
     let mpjpe = |prefix: &str| {
         results
             .iter()

@@ -91,3 +91,58 @@ fn index_then_query_finds_the_category() {
     let message = String::from_utf8_lossy(&out.stderr);
     assert!(message.contains("library.idx"), "{message}");
 }
+
+#[test]
+fn eval_draws_a_confusion_matrix_per_method() {
+    let Some(data) = bandai() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let mut args: Vec<String> = vec!["search".into(), "eval".into()];
+    for content in ["walk", "run", "raise-up-both-hands"] {
+        for id in ["001", "004", "007", "010"] {
+            args.push(
+                data.join(format!("dataset-2_{content}_normal_{id}.bvh"))
+                    .display()
+                    .to_string(),
+            );
+        }
+    }
+    let plots = dir.path().join("plots");
+    args.extend(
+        [
+            "--labels-from-name",
+            "bandai-content",
+            "--trees",
+            "5",
+            "--folds",
+            "2",
+            "--no-unseen",
+            "--no-takes",
+            "--json",
+            "--quiet",
+            "--plots",
+            plots.to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = mocap(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let methods = report["methods"].as_array().unwrap();
+    assert!(methods.len() >= 2, "forest and baselines: {methods:?}");
+    let drawn = std::fs::read_dir(&plots)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with("confusion-")
+        })
+        .count();
+    assert_eq!(drawn, 2 * methods.len(), "a PNG and an SVG per method");
+}

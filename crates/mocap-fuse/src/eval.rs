@@ -81,6 +81,12 @@ pub struct MethodResult {
     /// Hip-knee and knee-ankle length error against the measured lengths.
     pub bone_error_mm: f64,
     pub jitter_mm: f64,
+    /// Mean position error of each of the 25 joints (Kinect v2 order, mm).
+    #[serde(default)]
+    pub per_joint_mm: Vec<f64>,
+    /// Standard deviation over the runs of each joint's mean error (mm).
+    #[serde(default)]
+    pub per_joint_sd_mm: Vec<f64>,
     /// Runs averaged (clips x seeds).
     pub runs: usize,
 }
@@ -240,7 +246,18 @@ struct Sums {
     mpjpe: f64,
     bone: f64,
     jitter: f64,
+    per_joint: [f64; JOINT_COUNT],
+    per_joint_squares: [f64; JOINT_COUNT],
     runs: usize,
+}
+
+/// The metrics of one run (one clip, seed, sensor count and method).
+#[derive(Clone, Copy)]
+struct RunMetrics {
+    mpjpe: f64,
+    bone: f64,
+    jitter: f64,
+    per_joint: [f64; JOINT_COUNT],
 }
 
 /// Runs the evaluation.
@@ -381,13 +398,17 @@ pub fn evaluate_with(
                         Some(o) => run_method(&streams, &calibration, &truth, body_here, *o),
                         None => best_single(&streams, &calibration, &truth, &body),
                     };
-                    let Some((mpjpe, bone, jit)) = m else {
+                    let Some(m) = m else {
                         continue;
                     };
                     let s = &mut sums[ki][mi];
-                    s.mpjpe += mpjpe;
-                    s.bone += bone;
-                    s.jitter += jit;
+                    s.mpjpe += m.mpjpe;
+                    s.bone += m.bone;
+                    s.jitter += m.jitter;
+                    for n in 0..JOINT_COUNT {
+                        s.per_joint[n] += m.per_joint[n];
+                        s.per_joint_squares[n] += m.per_joint[n] * m.per_joint[n];
+                    }
                     s.runs += 1;
                 }
             }
@@ -406,6 +427,13 @@ pub fn evaluate_with(
                 mpjpe_mm: s.mpjpe / n,
                 bone_error_mm: s.bone / n,
                 jitter_mm: s.jitter / n,
+                per_joint_mm: s.per_joint.iter().map(|e| e / n).collect(),
+                per_joint_sd_mm: (0..JOINT_COUNT)
+                    .map(|j| {
+                        let mean = s.per_joint[j] / n;
+                        (s.per_joint_squares[j] / n - mean * mean).max(0.0).sqrt()
+                    })
+                    .collect(),
                 runs: s.runs,
             });
         }
@@ -436,18 +464,17 @@ fn metrics(
     poses: &[(f64, [Vec3; JOINT_COUNT])],
     truth: &GroundTruth,
     body: &BodyModel,
-) -> Option<(f64, f64, f64)> {
+) -> Option<RunMetrics> {
     if poses.is_empty() {
         return None;
     }
-    let mut error = 0.0;
+    let mut per_joint = [0.0; JOINT_COUNT];
     let mut bone = (0.0, 0usize);
     for (t, p) in poses {
         let g = truth.at(*t);
-        error += (0..JOINT_COUNT)
-            .map(|n| p[n].distance(g[n]) as f64)
-            .sum::<f64>()
-            / JOINT_COUNT as f64;
+        for n in 0..JOINT_COUNT {
+            per_joint[n] += p[n].distance(g[n]) as f64;
+        }
         for &n in &LEG_BONES {
             if let (Some(parent), Some(l)) = (crate::kinect::PARENTS[n], body.bone_lengths[n]) {
                 bone.0 += (p[n].distance(p[parent]) - l).abs() as f64;
@@ -456,11 +483,13 @@ fn metrics(
         }
     }
     let frames: Vec<[Vec3; JOINT_COUNT]> = poses.iter().map(|(_, p)| *p).collect();
-    Some((
-        1000.0 * error / poses.len() as f64,
-        1000.0 * bone.0 / bone.1.max(1) as f64,
-        jitter(&frames),
-    ))
+    let per_joint = per_joint.map(|e| 1000.0 * e / poses.len() as f64);
+    Some(RunMetrics {
+        mpjpe: per_joint.iter().sum::<f64>() / JOINT_COUNT as f64,
+        bone: 1000.0 * bone.0 / bone.1.max(1) as f64,
+        jitter: jitter(&frames),
+        per_joint,
+    })
 }
 
 /// Mean norm of the second difference over consecutive frames (mm).
@@ -482,7 +511,7 @@ fn run_method(
     truth: &GroundTruth,
     body: &BodyModel,
     options: FusionOptions,
-) -> Option<(f64, f64, f64)> {
+) -> Option<RunMetrics> {
     let mut fuser = Fuser::new(options, body.clone());
     let fused = fuse_streams(streams, calibration, &mut fuser, truth.fps, Some(0.0));
     let poses: Vec<(f64, [Vec3; JOINT_COUNT])> = fused
@@ -498,9 +527,9 @@ fn best_single(
     calibration: &Calibration,
     truth: &GroundTruth,
     body: &BodyModel,
-) -> Option<(f64, f64, f64)> {
+) -> Option<RunMetrics> {
     let period = 1.0 / truth.fps;
-    let mut best: Option<(f64, f64, f64)> = None;
+    let mut best: Option<RunMetrics> = None;
     for &sensor in streams.streams.keys() {
         let mut poses = Vec::new();
         let mut i = 0;
@@ -522,7 +551,7 @@ fn best_single(
             continue;
         }
         if let Some(m) = metrics(&poses, truth, body) {
-            if best.is_none_or(|b| m.0 < b.0) {
+            if best.is_none_or(|b| m.mpjpe < b.mpjpe) {
                 best = Some(m);
             }
         }

@@ -760,6 +760,9 @@ struct EvalArgs {
     /// Write the results as a Markdown table here.
     #[arg(long)]
     md: Option<PathBuf>,
+    /// Draw per-joint position errors (BVH) here: `per-joint-<K>-sensors.png` and `.svg`.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
 }
 
 fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
@@ -818,6 +821,9 @@ fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             progress.set_position(done as u64)
         })?;
         progress.finish_and_clear();
+        if let Some(dir) = &args.plots {
+            plot_per_joint_errors(&report, dir)?;
+        }
         (
             mocap_fuse::eval::report_markdown(&report, &command),
             serde_json::to_string_pretty(&report)?,
@@ -835,6 +841,57 @@ fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     }
     if args.json.as_deref() != Some(Path::new("-")) {
         println!("{markdown}");
+    }
+    Ok(())
+}
+
+/// Per sensor count, grouped bars of each joint's mean position error for
+/// the best single sensor, the report's baseline and method, and our best
+/// version, with the standard deviation over runs as error bars.
+fn plot_per_joint_errors(report: &mocap_fuse::eval::EvalReport, dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let shown = |name: &str| {
+        name == "best single sensor"
+            || name.starts_with("state only (")
+            || name.contains("(report method)")
+            || name.starts_with("best:")
+    };
+    let joints: Vec<String> = mocap_core::bodymap::KINECT_V2_JOINTS
+        .iter()
+        .map(|(name, _)| name.to_string())
+        .collect();
+    let mut counts: Vec<usize> = report.results.iter().map(|r| r.sensors).collect();
+    counts.dedup();
+    for k in counts {
+        let series: Vec<mocap_view::BarSeries> = report
+            .results
+            .iter()
+            .filter(|r| r.sensors == k && shown(&r.method) && r.per_joint_mm.len() == joints.len())
+            .map(|r| mocap_view::BarSeries {
+                label: format!("{} ({:.1} mm)", r.method, r.mpjpe_mm),
+                values: r.per_joint_mm.iter().map(|&v| v as f32).collect(),
+                errors: Some(r.per_joint_sd_mm.iter().map(|&v| v as f32).collect()),
+            })
+            .collect();
+        if series.is_empty() {
+            continue;
+        }
+        let plot = mocap_view::BarPlot {
+            title: format!(
+                "position error per joint, {k} sensors ({} takes x {} seeds; bars: sd over runs)",
+                report.clips.len(),
+                report.seeds.len()
+            ),
+            y_label: "mm".into(),
+            categories: joints.clone(),
+            series,
+            size: (1600, 600),
+        };
+        for extension in ["png", "svg"] {
+            let path = dir.join(format!("per-joint-{k}-sensors.{extension}"));
+            mocap_view::plot_bars(&path, &plot)
+                .with_context(|| format!("drawing {}", path.display()))?;
+        }
     }
     Ok(())
 }

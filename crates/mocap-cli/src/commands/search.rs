@@ -184,6 +184,9 @@ struct EvalArgs {
     /// Also write the report to this file.
     #[arg(long, short)]
     output: Option<PathBuf>,
+    /// Write a confusion matrix per method here (`confusion-<method>.png` and `.svg`).
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
 }
 
 pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
@@ -269,9 +272,61 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if let Some(path) = &a.output {
                 write_output(Some(path), |w| w.write_all(text.as_bytes()))?;
             }
+            if let Some(dir) = &a.plots {
+                let written = plot_confusions(&report, dir)?;
+                if !options.quiet {
+                    eprintln!("wrote {written} confusion matrices to {}", dir.display());
+                }
+            }
         }
     }
     Ok(())
+}
+
+/// One confusion matrix per method (rows: true class, as fractions of the
+/// row: each row's diagonal is the class's recall), PNG and SVG.
+fn plot_confusions(
+    report: &mocap_search::EvalReport,
+    dir: &std::path::Path,
+) -> anyhow::Result<usize> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let classes = report.classes.len();
+    let side = (240 + 28 * classes as u32).min(2000);
+    let mut written = 0;
+    for method in &report.methods {
+        let counts = (0..classes)
+            .map(|truth| {
+                (0..classes)
+                    .map(|predicted| method.confusion.count(truth, predicted) as f32)
+                    .collect()
+            })
+            .collect();
+        let plot = mocap_view::ConfusionPlot {
+            title: format!("{} (accuracy {:.3})", method.method, method.accuracy),
+            labels: report.classes.clone(),
+            counts,
+            normalise_rows: true,
+            size: (side, side),
+        };
+        let stem: String = method
+            .method
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '-'
+                }
+            })
+            .collect();
+        for extension in ["png", "svg"] {
+            let path = dir.join(format!("confusion-{stem}.{extension}"));
+            mocap_view::plot_confusion(&path, &plot)
+                .with_context(|| format!("drawing {}", path.display()))?;
+        }
+        written += 1;
+    }
+    Ok(written)
 }
 
 /// Prints a result as pretty JSON or as the text `to_text` gives.
