@@ -6,8 +6,9 @@
 //!
 //! The method, following the report this crate implements:
 //!
-//! 1. [`features`]: every frame becomes 56 numbers describing the pose in a
-//!    body-centred frame, divided by the body height;
+//! 1. [`features`]: every frame becomes 76 numbers describing the pose in a
+//!    body-centred frame, divided by the body height (the report uses 56;
+//!    which values and why are listed in [`features`]);
 //! 2. [`intervals`]: each clip is resampled to `N` frames (10) and each
 //!    value is averaged over every interval of those frames with running
 //!    sums, in constant time per interval;
