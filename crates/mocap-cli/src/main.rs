@@ -51,6 +51,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let options = commands::GlobalOptions { quiet: cli.quiet };
+    // The libraries' own progress bars (training) obey --quiet too.
+    mocap_nn::train::hide_progress(cli.quiet);
     let result = match cli.command {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),

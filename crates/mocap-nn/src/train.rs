@@ -55,10 +55,21 @@ impl History {
     }
 }
 
+/// Set by a front end's `--quiet`: no training progress bars at all.
+static PROGRESS_HIDDEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Hides (or shows again) every training progress bar of this process; the
+/// CLI calls it for `--quiet`.
+pub fn hide_progress(hidden: bool) {
+    PROGRESS_HIDDEN.store(hidden, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// A progress bar on stderr, hidden when stderr is not a terminal (logs and
-/// CI stay clean).
+/// CI stay clean) or after [`hide_progress`].
 pub fn progress_bar(steps: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if PROGRESS_HIDDEN.load(std::sync::atomic::Ordering::Relaxed)
+        || !std::io::stderr().is_terminal()
+    {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(steps);
