@@ -21,6 +21,10 @@ $BIN/train --data $DATA --out models/clean-default.safetensors --state bench/cle
   --plot bench/results/clean-default-training.png --epochs 40 --steps 40 --batch 512 --seed 1 --resume \
   --json bench/clean/default-train.json
 
+# Rotation representations and the position term (equal short budgets, first 40 test takes).
+bench/clean/compare_representations.sh
+bench/clean/position_loss.sh 0.001 0.01 0.1
+
 # 4. The shipped default continued at lower learning rates (same data stream, Adam state kept):
 #    epochs 41-50 at lr 3e-4, then 51-60 at lr 1e-4; the result replaced models/clean-default.safetensors
 #    after the 116-take evaluation (bench/clean/finetune/eval.md) measured it better on every metric.
@@ -28,3 +32,11 @@ bench/clean/finetune.sh lr3e-4 50 3e-4 0
 bench/clean/finetune.sh lr1e-4 60 1e-4 0 bench/clean/finetune/lr3e-4.state
 cp bench/clean/finetune/lr1e-4.safetensors models/clean-default.safetensors
 cp bench/clean/finetune/lr1e-4.png bench/results/clean-default-training.png
+
+# 5. The shipped model since: width 64 (1,019,396 parameters), 6 epochs x 20 steps (width.sh), then
+#    epochs 7-20 x 40 steps at lr 1e-3 and 21-24 at lr 3e-4 (width_long.sh); better than step 4's model on
+#    every metric of the 116-take evaluation (bench/clean/width/eval-long.md), so it replaced it.
+bench/clean/width.sh
+bench/clean/width_long.sh
+cp bench/clean/width/w64-long.safetensors models/clean-default.safetensors
+cp bench/clean/width/w64-long.png bench/results/clean-default-training.png
