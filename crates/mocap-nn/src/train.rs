@@ -83,6 +83,24 @@ pub fn progress_bar(steps: u64) -> ProgressBar {
     bar
 }
 
+/// A progress bar for other long work (evaluations): `len` items of
+/// `what`, hidden like [`progress_bar`].
+pub fn work_bar(len: u64, what: &str) -> ProgressBar {
+    if PROGRESS_HIDDEN.load(std::sync::atomic::Ordering::Relaxed)
+        || !std::io::stderr().is_terminal()
+    {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}, eta {eta}")
+            .expect("valid progress template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
 /// One optimiser step: back-propagates `loss` through `model` and updates
 /// its parameters with learning rate `lr`.
 pub fn optimizer_step<M: Module>(

@@ -616,6 +616,7 @@ fn evaluate_set(
 
     let mut pairs = Vec::new();
     let mut source_rows = Vec::new();
+    let bar = mocap_nn::train::work_bar(sources.len() as u64, &format!("{set}: sources restyled"));
     for source in &sources {
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
@@ -665,7 +666,9 @@ fn evaluate_set(
                 timings: StageTimings::default(),
             });
         }
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let filmstrips = match &options.filmstrips {
         Some(dir) => draw_filmstrips(
             model,
