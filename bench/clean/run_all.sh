@@ -40,3 +40,8 @@ bench/clean/width.sh
 bench/clean/width_long.sh
 cp bench/clean/width/w64-long.safetensors models/clean-default.safetensors
 cp bench/clean/width/w64-long.png bench/results/clean-default-training.png
+# 6. Then continued (width_longer.sh): epochs 25-32 at lr 3e-4, 33-36 at lr 1e-4; better again on every metric
+#    (bench/clean/width/eval-longer.md), so it replaced step 5's model.
+bench/clean/width_longer.sh
+cp bench/clean/width/w64-longer.safetensors models/clean-default.safetensors
+cp bench/clean/width/w64-longer.png bench/results/clean-default-training.png
