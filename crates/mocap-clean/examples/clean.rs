@@ -1,4 +1,4 @@
-//! Cleans one BVH take; stands in for `mocap clean IN -o OUT`.
+//! Cleans one BVH take: the library call behind `mocap clean IN -o OUT`.
 //!
 //! cargo run --release -p mocap-clean --example clean -- IN.bvh OUT.bvh \
 //!     [--model FILE.safetensors | --filter butterworth:2:6 | savitzky-golay:9:2 | median:9 | one-euro:1:0.05:1] \

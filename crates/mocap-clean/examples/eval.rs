@@ -1,4 +1,4 @@
-//! Evaluates methods on held-out takes; stands in for `mocap clean eval`.
+//! Evaluates methods on held-out takes: the library call behind `mocap clean eval`.
 //!
 //! cargo run --release -p mocap-clean --example eval -- --data ../shared/data/bandai \
 //!     [--model LABEL=FILE (LABEL without "=")]... [--no-default-model] [--no-filters] [--all-takes] \

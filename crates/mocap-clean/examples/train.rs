@@ -1,4 +1,4 @@
-//! Trains a denoiser; stands in for `mocap clean train` until the CLI wires it.
+//! Trains a denoiser: the library call behind `mocap clean train`, with every option spelled out.
 //!
 //! cargo run --release -p mocap-clean --example train -- \
 //!     --data ../shared/data/bandai --out models/clean-default.safetensors \
