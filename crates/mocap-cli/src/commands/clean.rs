@@ -89,6 +89,9 @@ struct TrainArgs {
     /// rot6d, expmap or euler.
     #[arg(long)]
     representation: Option<Representation>,
+    /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
+    #[arg(long)]
+    position_weight: Option<f32>,
     /// The report's large network (for a GPU) instead of the small default.
     #[arg(long)]
     large: bool,
@@ -237,6 +240,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.learning_rate, a.lr);
     set(&mut o.seed, a.seed);
     set(&mut o.representation, a.representation);
+    set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
     set(&mut o.network.levels, a.levels);
     set(&mut o.network.blocks, a.blocks);
