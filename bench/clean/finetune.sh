@@ -12,6 +12,6 @@ OUT=bench/clean/finetune
 NAME=$1; EPOCHS=$2; LR=$3; W=$4; FROM=${5:-bench/clean/default.state}
 mkdir -p $OUT
 if [ ! -d $OUT/$NAME.state ]; then cp -r $FROM $OUT/$NAME.state; fi
-$BIN/train --data $DATA --out $OUT/$NAME.safetensors --state $OUT/$NAME.state --plot $OUT/$NAME.png \
+$BIN/clean_train --data $DATA --out $OUT/$NAME.safetensors --state $OUT/$NAME.state --plot $OUT/$NAME.png \
   --epochs $EPOCHS --steps 40 --batch 512 --seed 1 --lr $LR --position-weight $W --resume \
   --json $OUT/$NAME-train.json

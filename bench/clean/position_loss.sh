@@ -14,10 +14,10 @@ WEIGHTS=${@:-0.01 0.1}
 MODELS=(--model "no position term=bench/clean/representations/rot6d.safetensors")
 for w in $WEIGHTS; do
   if [ ! -f $OUT/w$w.safetensors ]; then
-    $BIN/train --data $DATA --position-weight $w --out $OUT/w$w.safetensors --state $OUT/w$w.state \
+    $BIN/clean_train --data $DATA --position-weight $w --out $OUT/w$w.safetensors --state $OUT/w$w.state \
       --plot $OUT/w$w.png --epochs 6 --steps 20 --batch 512 --seed 1 --loss derivative --json $OUT/w$w-train.json
   fi
   MODELS+=(--model "position weight $w=$OUT/w$w.safetensors")
 done
-$BIN/eval --data $DATA --max-takes 40 --no-default-model --no-filters --spike-lengths 4,16 \
+$BIN/clean_eval --data $DATA --max-takes 40 --no-default-model --no-filters --spike-lengths 4,16 \
   "${MODELS[@]}" --json $OUT/eval.json --markdown $OUT/eval.md

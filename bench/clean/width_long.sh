@@ -8,5 +8,5 @@ DATA=../shared/data/bandai
 OUT=bench/clean/width
 if [ ! -d $OUT/w64-long.state ]; then cp -r $OUT/w64.state $OUT/w64-long.state; fi
 COMMON="--data $DATA --width 64 --out $OUT/w64-long.safetensors --state $OUT/w64-long.state --plot $OUT/w64-long.png --steps 40 --batch 512 --seed 1 --loss derivative --resume"
-$BIN/train $COMMON --epochs 20 --lr 1e-3 --json $OUT/w64-long-a-train.json
-$BIN/train $COMMON --epochs 24 --lr 3e-4 --json $OUT/w64-long-b-train.json
+$BIN/clean_train $COMMON --epochs 20 --lr 1e-3 --json $OUT/w64-long-a-train.json
+$BIN/clean_train $COMMON --epochs 24 --lr 3e-4 --json $OUT/w64-long-b-train.json

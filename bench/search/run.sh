@@ -14,13 +14,13 @@ OUT=bench/results/search.md
 TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT
 
-cargo build --release -p mocap-search --example eval --example bench
+cargo build --release -p mocap-search --example search_eval --example bench
 TARGET="${CARGO_TARGET_DIR:-target}/release/examples"
 
 run_eval() { # name, label pattern, folder...
     local name=$1 pattern=$2
     shift 2
-    local cmd="cargo run --release -p mocap-search --example eval -- --labels-from-name $pattern --folds 5 $*"
+    local cmd="cargo run --release -p mocap-search --example search_eval -- --labels-from-name $pattern --folds 5 $*"
     echo "== $name" >&2
     {
         echo "## $name"
@@ -49,7 +49,7 @@ done
 {
     echo "## content, trained on dataset-2 walk/run, tested on dataset-1 walk/run"
     echo
-    echo "Command: \`cargo run --release -p mocap-search --example eval -- --labels-from-name bandai-content --no-unseen --no-takes D2_WALK_RUN --test D1_WALK_RUN\` (folders of links to the walk_ and run_ files)"
+    echo "Command: \`cargo run --release -p mocap-search --example search_eval -- --labels-from-name bandai-content --no-unseen --no-takes D2_WALK_RUN --test D1_WALK_RUN\` (folders of links to the walk_ and run_ files)"
     echo
     "$TARGET/eval" --labels-from-name bandai-content --no-unseen --no-takes \
         --name "dataset-2 walk/run -> dataset-1 walk/run" "$TMP/d2-walk-run" --test "$TMP/d1-walk-run"

@@ -16,7 +16,7 @@ cd "$(dirname "$0")/../.."
 pattern=$1 folder=$2 seeds=${3:-20}
 shift $(($# >= 3 ? 3 : 2))
 [ "${1:-}" = "--" ] && shift
-EVAL=${EVAL:-${CARGO_TARGET_DIR:-target}/release/examples/eval}
+EVAL=${EVAL:-${CARGO_TARGET_DIR:-target}/release/examples/search_eval}
 TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT
 for s in $(seq 1 "$seeds"); do

@@ -33,7 +33,7 @@ if flag --train; then
   # The shipped default: the report's setting (240-frame windows, batch 16,
   # Adam, lr 1e-4), walking takes of both sets without the held-out takes,
   # with mirrored copies, seed 1.
-  "$BIN/train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
+  "$BIN/style_train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
     -o models/style-default.safetensors "$DATA/dataset-1" "$DATA/dataset-2" > "$OUT/train.json"
   cp models/style-default.png bench/style/loss.png
   # The loss plot goes to bench/style; the resumable state is not shipped.
@@ -56,17 +56,17 @@ if flag --classifiers; then
     --content-descriptor intervals "$DATA/dataset-2" > "$OUT/classifiers-d2-previous.json"
 fi
 
-"$BIN/eval" --sources walk,walk-turn-left,walk-turn-right --styles walk \
+"$BIN/style_eval" --sources walk,walk-turn-left,walk-turn-right --styles walk \
   --classifier-contents "$WALKS" --filmstrips bench/style/filmstrips \
   --json "$OUT/eval.json" --markdown "$OUT/eval.md" "$DATA/dataset-1" "$DATA/dataset-2"
 
-"$BIN/speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
+"$BIN/style_speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
   "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 | tee "$OUT/speed.md"
 
 if flag --patches; then
   # Sensitivity to the patch length (the default, 32, is the main run).
   for P in 16 24 48; do
-    "$BIN/eval" --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    "$BIN/style_eval" --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
       --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-p$P.json" \
       --markdown "$OUT/eval-p$P.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
   done
@@ -75,7 +75,7 @@ fi
 if flag --contacts; then
   # Foot-contact cleanup (two-bone IK pinning the ankles on the ground),
   # off by default: its trade-off is measured here.
-  "$BIN/eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+  "$BIN/style_eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
     --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-contacts.json" \
     --markdown "$OUT/eval-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 fi

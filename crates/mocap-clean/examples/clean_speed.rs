@@ -1,6 +1,6 @@
 //! Inference and training speed of a denoiser (a benchmark, not a test).
 //!
-//! cargo run --release -p mocap-clean --example speed -- --data ../shared/data/bandai \
+//! cargo run --release -p mocap-clean --example clean_speed -- --data ../shared/data/bandai \
 //!     [--model FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
 //!
 //! Inference: a clip of `frames` frames (takes of the data set joined end to

@@ -1,7 +1,7 @@
 //! Trains the style autoencoder (what `mocap style train` will do).
 //!
 //! ```text
-//! cargo run --release -p mocap-style --example train -- \
+//! cargo run --release -p mocap-style --example style_train -- \
 //!     [--epochs 30] [--steps 100] [--contents walk,walk-back] [--seed 1] \
 //!     -o models/style-default.safetensors DIR...
 //! ```

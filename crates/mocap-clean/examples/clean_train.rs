@@ -1,6 +1,6 @@
 //! Trains a denoiser: the library call behind `mocap clean train`, with every option spelled out.
 //!
-//! cargo run --release -p mocap-clean --example train -- \
+//! cargo run --release -p mocap-clean --example clean_train -- \
 //!     --data ../shared/data/bandai --out models/clean-default.safetensors \
 //!     [--epochs 20] [--steps 40] [--batch 512] [--lr 1e-3] [--seed 1] \
 //!     [--loss derivative|mse] [--representation rot6d|expmap|euler] \

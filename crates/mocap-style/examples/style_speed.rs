@@ -1,7 +1,7 @@
 //! Time to restyle a 10-second clip, and the share of each stage.
 //!
 //! ```text
-//! cargo run --release -p mocap-style --example speed -- SOURCE STYLE_CLIP [--model M] [--runs 20]
+//! cargo run --release -p mocap-style --example style_speed -- SOURCE STYLE_CLIP [--model M] [--runs 20]
 //! ```
 //!
 //! The source is cut (or its frames used) to its first 10 seconds; each run

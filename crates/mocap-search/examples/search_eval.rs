@@ -2,7 +2,7 @@
 //! prints the Markdown report (or JSON with `--json`).
 //!
 //! ```text
-//! cargo run --release -p mocap-search --example eval -- \
+//! cargo run --release -p mocap-search --example search_eval -- \
 //!     --labels-from-name bandai-content --folds 5 ../shared/data/bandai/dataset-2
 //! ```
 //!

@@ -1,7 +1,7 @@
 //! Evaluates style transfer on labelled clips (what `mocap style eval` will do).
 //!
 //! ```text
-//! cargo run --release -p mocap-style --example eval -- \
+//! cargo run --release -p mocap-style --example style_eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
 //!     [--classifier-contents walk,walk-back] [--patch 32] [--foot-contacts] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...

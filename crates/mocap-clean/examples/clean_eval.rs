@@ -1,6 +1,6 @@
 //! Evaluates methods on held-out takes: the library call behind `mocap clean eval`.
 //!
-//! cargo run --release -p mocap-clean --example eval -- --data ../shared/data/bandai \
+//! cargo run --release -p mocap-clean --example clean_eval -- --data ../shared/data/bandai \
 //!     [--model LABEL=FILE (LABEL without "=")]... [--no-default-model] [--no-filters] [--all-takes] \
 //!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] \
 //!     [--json OUT.json] [--markdown OUT.md]
