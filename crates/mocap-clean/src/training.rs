@@ -17,9 +17,9 @@ use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{save_weights, CheckpointHeader, TrainingState};
+use mocap_nn::checkpoint::{save_epoch, CheckpointHeader, Progress, TrainingState};
 use mocap_nn::device::{seed_device, DeviceChoice};
-use mocap_nn::plot::{history_series, plot_lines, PlotOptions};
+use mocap_nn::plot::PlotOptions;
 use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
 use rand::rngs::ChaCha8Rng;
 use rand::{Rng, RngExt, SeedableRng};
@@ -278,11 +278,6 @@ fn validation_mse(
     sum / batches.len().max(1) as f64
 }
 
-#[derive(Serialize, Deserialize)]
-struct Progress {
-    history: History,
-}
-
 fn with_extension(path: &Path, extension: &str) -> PathBuf {
     path.with_extension(extension)
 }
@@ -479,17 +474,15 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         },
         |run, history| {
             let model = run.model.as_ref().expect("model");
-            state.save(
+            save_epoch(
+                &state,
                 model,
                 &run.optimizer,
-                &Progress {
-                    history: history.clone(),
-                },
-            )?;
-            save_weights(&options.out, &model.valid(), &header(history))?;
-            plot_lines(
+                history,
+                &options.out,
+                &model.valid(),
+                &header(history),
                 &plot,
-                &history_series(history, ""),
                 &PlotOptions {
                     y_label: "loss (training: chosen loss; validation: MSE)".into(),
                     ..PlotOptions::new(format!(

@@ -256,3 +256,41 @@ impl TrainingState {
         Ok((module, optimizer, progress))
     }
 }
+
+/// What a resumable training state records besides the weights and the
+/// optimizer: the history of the epochs run so far.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Progress {
+    pub history: crate::train::History,
+}
+
+/// What every learned capability writes at the end of an epoch, in this
+/// order: the resumable state (`state`), the model file `out` (so an
+/// interrupted run still leaves a usable model of its last finished epoch)
+/// and the loss curves `plot`.
+#[allow(clippy::too_many_arguments)]
+pub fn save_epoch<M: Module>(
+    state: &TrainingState,
+    training_model: &M,
+    optimizer: &ModuleOptimizer,
+    history: &crate::train::History,
+    out: &Path,
+    inference_model: &impl Module,
+    header: &CheckpointHeader,
+    plot: &Path,
+    plot_options: &crate::plot::PlotOptions,
+) -> Result<()> {
+    state.save(
+        training_model,
+        optimizer,
+        &Progress {
+            history: history.clone(),
+        },
+    )?;
+    save_weights(out, inference_model, header)?;
+    crate::plot::plot_lines(
+        plot,
+        &crate::plot::history_series(history, ""),
+        plot_options,
+    )
+}

@@ -23,10 +23,11 @@ use mocap_core::ops::resample_fps;
 use mocap_core::rotation::Quat;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader, TrainingState,
+    header_from_bytes, load_weights_from_bytes, save_epoch, CheckpointHeader, Progress,
+    TrainingState,
 };
 use mocap_nn::device::{seed_device, DeviceChoice};
-use mocap_nn::plot::{history_series, plot_lines, PlotOptions};
+use mocap_nn::plot::PlotOptions;
 use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
@@ -319,11 +320,6 @@ impl<'a> WindowSampler<'a> {
     }
 }
 
-#[derive(Serialize, Deserialize)]
-struct Progress {
-    history: History,
-}
-
 /// Trains an autoencoder (see the module docs).
 pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let started = Instant::now();
@@ -523,17 +519,15 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         },
         |run, history| -> Result<()> {
             let model = run.model.as_ref().expect("model");
-            state.save(
+            save_epoch(
+                &state,
                 model,
                 &run.optimizer,
-                &Progress {
-                    history: history.clone(),
-                },
-            )?;
-            save_weights(&options.out, &model.valid(), &header(history))?;
-            plot_lines(
+                history,
+                &options.out,
+                &model.valid(),
+                &header(history),
                 &plot,
-                &history_series(history, ""),
                 &PlotOptions {
                     y_label: "mean squared error (standardised features)".into(),
                     ..PlotOptions::new("mocap-style autoencoder training")
