@@ -115,10 +115,13 @@ impl CleanModel {
         let c = layout.channels();
         if c != self.description.network.channels {
             return Err(CleanError::Invalid(format!(
-                "the model expects {} rotation features ({} joints), the take has {c} ({} joints with rotations)",
-                self.description.network.channels,
+                "the model was trained on a rig of {} joints with rotations ({}, ...), this take \
+                 has {} ({c} features against {}): clean it with --filter, or train a model on \
+                 this rig with `mocap clean train`",
                 self.description.joints.len(),
-                layout.joints.len()
+                self.description.joints[..self.description.joints.len().min(3)].join(", "),
+                layout.joints.len(),
+                self.description.network.channels,
             )));
         }
         let t = self.description.network.window;
@@ -257,7 +260,12 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                 _ => CleanModel::load_default(options.device)?,
             };
             let start = Instant::now();
-            let out = model.clean(&motion, options.hop)?;
+            let out = model.clean(&motion, options.hop).map_err(|e| match e {
+                CleanError::Invalid(m) => {
+                    CleanError::Invalid(format!("{}: {m}", options.input.display()))
+                }
+                other => other,
+            })?;
             (
                 out,
                 format!("model {}", model.source.display()),

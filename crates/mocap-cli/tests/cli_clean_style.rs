@@ -217,3 +217,49 @@ fn style_apply_restyles_the_bundled_walk() {
     assert!(stderr(&out).contains("nope.bvh"), "{}", stderr(&out));
     assert!(!dir.path().join("x.bvh").exists());
 }
+
+#[test]
+fn unusable_inputs_are_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    // A style clip shorter than one patch.
+    let short = dir.path().join("short-style.bvh");
+    let out = mocap(&[
+        "convert",
+        &sample("dataset-1_walk_proud_001.bvh"),
+        path(&short),
+        "--frames",
+        "0..8",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let output = dir.path().join("out.bvh");
+    let out = mocap(&[
+        "style",
+        "apply",
+        &sample("dataset-1_walk_normal_001.bvh"),
+        "--style",
+        path(&short),
+        "-o",
+        path(&output),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("short-style.bvh") && stderr(&out).contains("too short"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!output.exists());
+
+    // A take of another rig than the shipped denoiser's.
+    let Some(other_rig) = mocap_testdata::shared("parser-cases/bvhanim_test_mocapbank.bvh") else {
+        return;
+    };
+    let out = mocap(&["clean", path(&other_rig), "-o", path(&output)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("bvhanim_test_mocapbank.bvh") && stderr(&out).contains("--filter"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!output.exists());
+}

@@ -317,6 +317,30 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         )?),
         None => None,
     };
+    // Checked here as well as in `convert`, to name the file.
+    if matches!(
+        options.method,
+        Method::ElasticPatches | Method::FixedPatches
+    ) {
+        let clips = std::iter::once((&style_clip, &options.style))
+            .chain(other.iter().zip(blend.iter().map(|b| b.2)));
+        for (clip, path) in clips {
+            let frames = clip
+                .sequences
+                .iter()
+                .map(|(l, _)| l.frames)
+                .max()
+                .unwrap_or(0);
+            if frames < options.patch {
+                return Err(invalid(format!(
+                    "{}: the style clip is too short: {frames} frames, a patch needs {} \
+                     (use a longer clip, or a shorter --patch)",
+                    path.display(),
+                    options.patch
+                )));
+            }
+        }
+    }
     let mut styles = vec![(&style_clip, 1.0 - blend.as_ref().map_or(0.0, |b| b.1))];
     if let (Some(o), Some((_, w, _))) = (&other, &blend) {
         styles.push((o, *w));
