@@ -292,6 +292,10 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             .collect();
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
         let mut frames_total = 0usize;
+        let bar = mocap_nn::train::work_bar(
+            takes.len() as u64,
+            &format!("takes cleaned ({} noise)", CONDITIONS[condition]),
+        );
         for i in 0..takes.len() {
             let clean = &takes[i].motion;
             let noisy = make_noisy(&takes, i, condition, options)?;
@@ -308,7 +312,9 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             for (k, (_, cleaner)) in methods.iter().enumerate() {
                 add(k + 1, &cleaner.run(&noisy)?);
             }
+            bar.inc(1);
         }
+        bar.finish_and_clear();
         let names = std::iter::once("noisy input").chain(methods.iter().map(|(l, _)| *l));
         for (name, s) in names.zip(&sums) {
             let n = frames_total.max(1) as f64;
