@@ -449,20 +449,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             if let Some(fk) = &fk {
                 l = l + position_loss(fk, pred, target) * options.position_weight;
             }
-            let value: f32 = l.clone().into_scalar();
-            if !value.is_finite() {
-                return Err(CleanError::Invalid(format!(
-                    "the training loss became {value} at epoch {}: lower the learning rate",
-                    epoch + 1
-                )));
-            }
-            run.model = Some(optimizer_step(
-                model,
-                &mut run.optimizer,
-                l,
-                options.learning_rate,
-            ));
-            Ok(value as f64)
+            let (model, value) =
+                optimizer_step(model, &mut run.optimizer, l, options.learning_rate);
+            run.model = Some(model);
+            Ok(value)
         },
         |run, _epoch| {
             Ok(validation_mse(

@@ -38,6 +38,9 @@ pub enum NnError {
     /// A device that this build cannot use.
     #[error("{0}")]
     Device(String),
+    /// The training loss stopped being a number: training diverged.
+    #[error("the training loss became {loss} at epoch {epoch}: lower the learning rate")]
+    Diverged { loss: f64, epoch: usize },
     /// Drawing a plot failed.
     #[error("{path}: cannot draw the plot: {message}")]
     Plot {

@@ -14,6 +14,8 @@ use burn::tensor::Tensor;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 
+use crate::NnError;
+
 /// Losses and timing of one epoch.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EpochRecord {
@@ -102,15 +104,17 @@ pub fn work_bar(len: u64, what: &str) -> ProgressBar {
 }
 
 /// One optimiser step: back-propagates `loss` through `model` and updates
-/// its parameters with learning rate `lr`.
+/// its parameters with learning rate `lr`. Returns the updated model and the
+/// loss value (for the progress bar and [`run_epochs`]' divergence check).
 pub fn optimizer_step<M: Module>(
     model: M,
     optimizer: &mut ModuleOptimizer,
     loss: Tensor<1>,
     lr: f64,
-) -> M {
+) -> (M, f64) {
+    let value: f32 = loss.clone().into_scalar();
     let grads = GradientsParams::from_grads(loss.backward(), &model);
-    optimizer.step(lr, model, grads)
+    (optimizer.step(lr, model, grads), value as f64)
 }
 
 /// Sizes of a training run.
@@ -128,8 +132,11 @@ pub struct EpochPlan {
 ///
 /// `train_step(state, epoch, step)` does one optimiser step and returns its
 /// loss; `validate(state, epoch)` returns the validation loss;
-/// `after_epoch(state, history)` runs after each epoch (checkpointing).
-pub fn run_epochs<S, E>(
+/// `after_epoch(state, history)` runs after each epoch (checkpointing). A
+/// loss that is not a finite number stops the run with
+/// [`NnError::Diverged`] before the epoch is recorded, so the last saved
+/// epoch stays the last good one.
+pub fn run_epochs<S, E: From<NnError>>(
     state: &mut S,
     history: &mut History,
     plan: EpochPlan,
@@ -147,6 +154,13 @@ pub fn run_epochs<S, E>(
         let mut sum = 0.0;
         for step in 0..plan.steps_per_epoch {
             let loss = train_step(state, epoch, step)?;
+            if !loss.is_finite() {
+                return Err(NnError::Diverged {
+                    loss,
+                    epoch: epoch + 1,
+                }
+                .into());
+            }
             sum += loss;
             bar.inc(1);
             bar.set_message(format!(
@@ -192,6 +206,45 @@ mod tests {
     use burn::optim::AdamConfig;
     use burn::tensor::Device;
 
+    /// A loss that turns into NaN stops the run at that epoch, after the
+    /// epochs before it were recorded and saved.
+    #[test]
+    fn a_diverging_loss_stops_the_run() {
+        let mut history = History::default();
+        let mut saved = 0;
+        let plan = EpochPlan {
+            epochs: 5,
+            steps_per_epoch: 3,
+            batch_size: 1,
+        };
+        let result = run_epochs(
+            &mut saved,
+            &mut history,
+            plan,
+            |_, epoch, step| {
+                Ok(if epoch == 2 && step == 1 {
+                    f64::NAN
+                } else {
+                    1.0
+                })
+            },
+            |_, _| Ok(1.0),
+            |saved, _| {
+                *saved += 1;
+                Ok::<(), NnError>(())
+            },
+        );
+        match result {
+            Err(NnError::Diverged { loss, epoch }) => {
+                assert!(loss.is_nan());
+                assert_eq!(epoch, 3);
+            }
+            other => panic!("expected Diverged, got {other:?}"),
+        }
+        assert_eq!(history.epochs.len(), 2);
+        assert_eq!(saved, 2);
+    }
+
     /// Fits y = 2x + 1 with the loop and Adam: the loss must fall.
     #[test]
     fn loop_fits_a_line() {
@@ -216,9 +269,9 @@ mod tests {
             plan,
             |(model, optimizer), _, _| {
                 let loss = (model.forward(x.clone()) - y.clone()).powi_scalar(2).mean();
-                let value: f32 = loss.clone().into_scalar();
-                **model = optimizer_step((**model).clone(), optimizer, loss, 0.05);
-                Ok::<f64, ()>(value as f64)
+                let (updated, value) = optimizer_step((**model).clone(), optimizer, loss, 0.05);
+                **model = updated;
+                Ok::<f64, NnError>(value)
             },
             |(model, _), _| {
                 let loss = (model.forward(x.clone()) - y.clone()).powi_scalar(2).mean();

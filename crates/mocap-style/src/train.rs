@@ -493,20 +493,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             let x = Tensor::<3>::from_data(TensorData::new(x, shape), &device);
             let model = run.model.take().expect("model present");
             let loss = (model.forward(x.clone()) - x).powi_scalar(2).mean();
-            let value: f32 = loss.clone().into_scalar();
-            if !value.is_finite() {
-                return Err(invalid(format!(
-                    "the training loss became {value} at epoch {}: lower the learning rate",
-                    epoch + 1
-                )));
-            }
-            run.model = Some(optimizer_step(
-                model,
-                &mut run.optimizer,
-                loss,
-                options.learning_rate,
-            ));
-            Ok(value as f64)
+            let (model, value) =
+                optimizer_step(model, &mut run.optimizer, loss, options.learning_rate);
+            run.model = Some(model);
+            Ok(value)
         },
         |run, _epoch| {
             let model = run.model.as_ref().expect("model").valid();
