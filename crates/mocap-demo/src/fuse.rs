@@ -21,13 +21,14 @@ use std::time::Duration;
 use anyhow::{anyhow, Context};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::Vec3;
-use mocap_fuse::body::{BodyModel, MeasureOptions};
 use mocap_fuse::bvh::{fit_error, fused_to_motion, poses_to_motion, regular_poses, BvhOptions};
 use mocap_fuse::fusion::{FusedFrame, FusionOptions};
 use mocap_fuse::kinect::JOINT_COUNT;
 use mocap_fuse::net::{self, MemorySink, SendOptions, ServeOptions, ServeReport};
 use mocap_fuse::offline::{views_at, SensorStreams};
-use mocap_fuse::sim::{center_truth, simulate, truth_from_motion, GroundTruth, SimulationOptions};
+use mocap_fuse::sim::{
+    center_truth, measure_person, simulate, truth_from_motion, GroundTruth, SimulationOptions,
+};
 use mocap_view::{plot_lines, render_files, LinePlot, RenderOptions, Series};
 
 use crate::{viewer_command, StageContext, StageReport, StageResult};
@@ -102,18 +103,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     center_truth(&mut truth, simulation.treadmill_above);
     let sim = simulate(&truth, &simulation);
     // The person, measured from another capture (other seed) of the take.
-    let measuring = SimulationOptions {
-        seed: options.seed ^ 0x5eed_5eed,
-        ..simulation
-    };
-    let measure_sim = simulate(&truth, &measuring);
-    let body = BodyModel::measure(
-        measure_sim
-            .sensors
-            .iter()
-            .flat_map(|s| s.frames.iter().map(|f| &f.joints)),
-        MeasureOptions::default(),
-    );
+    let body = measure_person(&truth, &simulation);
     let calibration = sim.calibration();
     let frames: Vec<_> = sim
         .sensors

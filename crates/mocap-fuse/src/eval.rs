@@ -28,7 +28,9 @@ use crate::confidence::BoneLengthFunction;
 use crate::fusion::{Fuser, FusionOptions, OneEuroParams};
 use crate::kinect::{joint::*, JOINT_COUNT};
 use crate::offline::{fuse_streams, views_at, SensorStreams};
-use crate::sim::{center_truth, simulate, truth_from_motion, GroundTruth, SimulationOptions};
+use crate::sim::{
+    center_truth, measure_person, simulate, truth_from_motion, GroundTruth, SimulationOptions,
+};
 
 /// How the sensors' poses are known in the evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -307,16 +309,7 @@ pub fn evaluate_with(
                 sim_options.seed = seed.wrapping_mul(1_000_003).wrapping_add(k as u64);
                 let sim = simulate(&truth, &sim_options);
                 // The person, measured from another capture of the take.
-                let mut measuring = sim_options;
-                measuring.seed = sim_options.seed ^ 0x5eed_5eed;
-                let measure_sim = simulate(&truth, &measuring);
-                let body = BodyModel::measure(
-                    measure_sim
-                        .sensors
-                        .iter()
-                        .flat_map(|s| s.frames.iter().map(|f| &f.joints)),
-                    MeasureOptions::default(),
-                );
+                let body = measure_person(&truth, &sim_options);
                 let streams =
                     SensorStreams::new(sim.sensors.iter().flat_map(|s| s.frames.iter().cloned()));
                 for s in &sim.sensors {

@@ -48,6 +48,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 
+use crate::body::{BodyModel, MeasureOptions};
 use crate::calib::{Calibration, RigidTransform, SensorPose};
 use crate::kinect::{joint::*, TrackingState, JOINT_COUNT, MIRROR};
 use crate::recording::{JointObservation, SensorFrame};
@@ -479,6 +480,27 @@ pub fn center_truth(truth: &mut GroundTruth, treadmill_above: Option<f32>) {
             *p -= shift;
         }
     }
+}
+
+/// The person as `mocap fuse measure` would measure them beforehand: bone
+/// lengths and joint ranges from a second simulated capture of the same take
+/// (other seed, so other sensor places and noise), never from the capture
+/// being fused.
+pub fn measure_person(truth: &GroundTruth, options: &SimulationOptions) -> BodyModel {
+    let measuring = simulate(
+        truth,
+        &SimulationOptions {
+            seed: options.seed ^ 0x5eed_5eed,
+            ..*options
+        },
+    );
+    BodyModel::measure(
+        measuring
+            .sensors
+            .iter()
+            .flat_map(|s| s.frames.iter().map(|f| &f.joints)),
+        MeasureOptions::default(),
+    )
 }
 
 /// Simulates `options.sensors` sensors watching `truth` (already centred,

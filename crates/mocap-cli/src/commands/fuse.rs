@@ -161,20 +161,7 @@ fn simulate(args: SimulateArgs, _options: &GlobalOptions) -> anyhow::Result<()> 
     let simulation = sim::simulate(&truth, &sim_options);
     // The person, measured beforehand: from a second capture of the take
     // (other sensor places and noise), as `mocap fuse measure` would.
-    let measuring = sim::simulate(
-        &truth,
-        &sim::SimulationOptions {
-            seed: args.seed ^ 0x5eed_5eed,
-            ..sim_options
-        },
-    );
-    let body = BodyModel::measure(
-        measuring
-            .sensors
-            .iter()
-            .flat_map(|s| s.frames.iter().map(|f| &f.joints)),
-        MeasureOptions::default(),
-    );
+    let body = sim::measure_person(&truth, &sim_options);
     let files = sim::write_simulation(&args.out, &simulation, &body, args.seed, args.ntu)?;
     let report = SimulateReport {
         sensors: simulation
