@@ -343,13 +343,7 @@ impl Recentering {
     pub fn apply(&self, window: &mut [f32]) {
         match self {
             Recentering::None => {}
-            Recentering::Offsets(offsets) => {
-                for frame in window.chunks_mut(offsets.len()) {
-                    for (v, o) in frame.iter_mut().zip(offsets) {
-                        *v -= o;
-                    }
-                }
-            }
+            Recentering::Offsets(offsets) => add_per_frame(window, offsets, -1.0),
             Recentering::Flipped(flipped) => flip(flipped, window),
         }
     }
@@ -360,15 +354,19 @@ impl Recentering {
     pub fn undo(&self, window: &mut [f32]) {
         match self {
             Recentering::None => {}
-            Recentering::Offsets(offsets) => {
-                for frame in window.chunks_mut(offsets.len()) {
-                    for (v, o) in frame.iter_mut().zip(offsets) {
-                        *v += o;
-                    }
-                }
-            }
+            Recentering::Offsets(offsets) => add_per_frame(window, offsets, 1.0),
             // Switching branch is its own inverse.
             Recentering::Flipped(flipped) => flip(flipped, window),
+        }
+    }
+}
+
+/// Adds `sign * offsets` to every frame of `window` (frames of
+/// `offsets.len()` channels).
+fn add_per_frame(window: &mut [f32], offsets: &[f32], sign: f32) {
+    for frame in window.chunks_mut(offsets.len()) {
+        for (v, o) in frame.iter_mut().zip(offsets) {
+            *v += sign * o;
         }
     }
 }
