@@ -4,7 +4,7 @@
 //! cargo run -p mocap-clean --example joint_errors -- TAKE.bvh [MODEL]
 
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::add_random_noise_sigma;
+use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::joint_rotation_errors_degrees;
 use rand::SeedableRng;
@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => CleanModel::load_default(Default::default())?,
     };
     let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(1);
-    let noisy = add_random_noise_sigma(&motion, 5.0, true, &mut rng);
+    let noisy = add_random_noise_sigma(&motion, 5.0, &RandomNoise::default(), &mut rng);
     let on_clean = model.clean(&motion, None)?;
     let on_noisy = model.clean(&noisy, None)?;
     let e_clean = joint_rotation_errors_degrees(&motion, &on_clean)?;

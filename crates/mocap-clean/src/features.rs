@@ -15,12 +15,18 @@
 //!   along time (`unwrap_track`), then each window shifted by whole turns so
 //!   that its first frame lies in (-180, 180]; this is what the report feeds,
 //!   and it keeps gimbal-lock discontinuities.
+//!
+//! Frames ([`RotationFrame`]): each joint's rotation is either its local
+//! rotation (relative to its parent, what BVH stores) or, for the joints
+//! below the pelvis, its rotation relative to the pelvis (the product of the
+//! local rotations from the pelvis down to the joint). See
+//! [`RotationFrame::Pelvis`] for why the second suits capture noise.
 
 use mocap_core::rotation::{
     euler_to_quat, expmap_to_quat, quat_to_6d, quat_to_expmap, rot6d_to_quat, unwrap_track,
     AngleUnit, EulerOrder, Quat, Vec3,
 };
-use mocap_core::{Motion, Skeleton};
+use mocap_core::{forward_kinematics, Motion, Skeleton};
 use serde::{Deserialize, Serialize};
 
 use crate::{CleanError, Result};
@@ -67,15 +73,70 @@ impl std::str::FromStr for Representation {
     }
 }
 
+/// Which rotation of each joint is a feature.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RotationFrame {
+    /// The local rotation of each joint, relative to its parent (what BVH
+    /// stores).
+    #[default]
+    Local,
+    /// For the joints below the pelvis, the rotation relative to the pelvis
+    /// `P^-1 G_j` (`G` global rotations); the pelvis and the joints above it
+    /// keep their local rotations (so the heading stays where it was and the
+    /// features do not depend on which way the performer faces). The pelvis
+    /// is found from the hierarchy alone
+    /// ([`Skeleton::first_branching_joint`]: `Hips` in Bandai and CMU BVH,
+    /// `root` in ASF).
+    ///
+    /// Why: markerless capture errs on each keypoint on its own, so its
+    /// rotation errors are independent per joint in *global* terms, and the
+    /// chain-corrected noise ([`crate::noise`]) is built that way. In local
+    /// terms each joint's error also carries its parent's error, undone: the
+    /// errors of parent and child compensate each other, and a network that
+    /// reduces them one joint at a time breaks the compensation, so the
+    /// positions get worse while the rotations get better. Relative to the
+    /// pelvis the errors stay independent per joint (plus the pelvis's own,
+    /// which all joints share).
+    Pelvis,
+}
+
+impl RotationFrame {
+    pub fn name(self) -> &'static str {
+        match self {
+            RotationFrame::Local => "local",
+            RotationFrame::Pelvis => "pelvis",
+        }
+    }
+}
+
+impl std::str::FromStr for RotationFrame {
+    type Err = CleanError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "local" => Ok(RotationFrame::Local),
+            "pelvis" => Ok(RotationFrame::Pelvis),
+            _ => Err(CleanError::Invalid(format!(
+                "unknown rotation frame `{s}`: expected local or pelvis"
+            ))),
+        }
+    }
+}
+
 /// Which joints are features and how: the joints with three rotation
 /// channels, in skeleton order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeatureLayout {
     pub representation: Representation,
+    pub frame: RotationFrame,
     /// Joint indices with features.
     pub joints: Vec<usize>,
     /// Euler order of each of those joints.
     orders: Vec<EulerOrder>,
+    /// The pelvis (see [`RotationFrame::Pelvis`]).
+    pelvis: usize,
+    /// Per skeleton joint: whether it lies below the pelvis.
+    below_pelvis: Vec<bool>,
 }
 
 impl FeatureLayout {
@@ -106,11 +167,63 @@ impl FeatureLayout {
                 "the skeleton has no rotation channels".into(),
             ));
         }
+        let pelvis = skeleton.first_branching_joint();
+        let mut below_pelvis = vec![false; skeleton.joint_count()];
+        for (j, joint) in skeleton.joints().iter().enumerate() {
+            if let Some(p) = joint.parent {
+                // Parents come before their children (checked by `Skeleton`).
+                below_pelvis[j] = p == pelvis || below_pelvis[p];
+            }
+        }
         Ok(FeatureLayout {
             representation,
+            frame: RotationFrame::Local,
             joints,
             orders,
+            pelvis,
+            below_pelvis,
         })
+    }
+
+    /// The same layout with rotations in `frame`. Euler angles only come in
+    /// the local frame: their channel order is the joint's own.
+    pub fn in_frame(mut self, frame: RotationFrame) -> Result<FeatureLayout> {
+        if frame != RotationFrame::Local && self.representation == Representation::Euler {
+            return Err(CleanError::Invalid(format!(
+                "Euler angles are local rotations; rotations in the {} frame need rot6d or expmap",
+                frame.name()
+            )));
+        }
+        self.frame = frame;
+        Ok(self)
+    }
+
+    /// The rotation of every feature joint in every frame, in the layout's
+    /// frame (frame after frame, `joints.len()` per frame).
+    fn feature_rotations(&self, motion: &Motion) -> Vec<Quat> {
+        let frames = motion.frame_count();
+        let mut out = Vec::with_capacity(frames * self.joints.len());
+        match self.frame {
+            RotationFrame::Local => {
+                for f in 0..frames {
+                    out.extend(self.joints.iter().map(|&j| motion.local_rotation(f, j)));
+                }
+            }
+            RotationFrame::Pelvis => {
+                let poses = forward_kinematics(motion);
+                for f in 0..frames {
+                    let pelvis = poses.rotation(f, self.pelvis).conjugate();
+                    out.extend(self.joints.iter().map(|&j| {
+                        if self.below_pelvis[j] {
+                            (pelvis * poses.rotation(f, j)).normalize()
+                        } else {
+                            motion.local_rotation(f, j)
+                        }
+                    }));
+                }
+            }
+        }
+        out
     }
 
     /// Features per frame.
@@ -124,22 +237,25 @@ impl FeatureLayout {
         let dim = self.representation.dim();
         let c = self.channels();
         let mut out = vec![0.0; frames * c];
+        let n = self.joints.len();
         match self.representation {
             Representation::Rot6d => {
+                let rotations = self.feature_rotations(motion);
                 for f in 0..frames {
-                    for (k, &j) in self.joints.iter().enumerate() {
-                        let r = quat_to_6d(motion.local_rotation(f, j));
+                    for k in 0..n {
+                        let r = quat_to_6d(rotations[f * n + k]);
                         out[f * c + k * dim..f * c + (k + 1) * dim].copy_from_slice(&r);
                     }
                 }
             }
             Representation::ExpMap => {
-                for (k, &j) in self.joints.iter().enumerate() {
+                let rotations = self.feature_rotations(motion);
+                for k in 0..n {
                     let mut previous = Quat::IDENTITY;
                     for f in 0..frames {
                         // Keep the quaternion on the hemisphere of the previous
                         // frame's, so the rotation vector does not flip needlessly.
-                        let mut q = motion.local_rotation(f, j);
+                        let mut q = rotations[f * n + k];
                         if q.dot(previous) < 0.0 {
                             q = -q;
                         }
@@ -288,7 +404,8 @@ impl FeatureLayout {
         }
     }
 
-    /// The local rotation of feature joint `k` from one frame's features.
+    /// The rotation of feature joint `k` from one frame's features, in the
+    /// layout's frame.
     pub fn rotation(&self, frame_features: &[f32], k: usize) -> Quat {
         let dim = self.representation.dim();
         let v = &frame_features[k * dim..(k + 1) * dim];
@@ -303,11 +420,38 @@ impl FeatureLayout {
     /// rotation channels; position channels are left as they are.
     pub fn decode_into(&self, features: &[f32], motion: &mut Motion) {
         let c = self.channels();
+        let joint_count = motion.skeleton().joint_count();
+        let mut feature_of = vec![None; joint_count];
+        for (k, &j) in self.joints.iter().enumerate() {
+            feature_of[j] = Some(k);
+        }
+        // Rotations relative to the pelvis of the frame being decoded.
+        let mut relative = vec![Quat::IDENTITY; joint_count];
         for f in 0..motion.frame_count() {
             let frame = &features[f * c..(f + 1) * c];
-            for (k, &j) in self.joints.iter().enumerate() {
-                let q = self.rotation(frame, k);
-                motion.set_local_rotation(f, j, q);
+            for j in 0..joint_count {
+                let decoded = feature_of[j].map(|k| self.rotation(frame, k));
+                let parent = motion.skeleton().joint(j).parent;
+                match (self.frame, parent) {
+                    (RotationFrame::Pelvis, Some(p)) if self.below_pelvis[j] => {
+                        // `relative[pelvis]` stays the identity.
+                        let r =
+                            decoded.unwrap_or_else(|| relative[p] * motion.local_rotation(f, j));
+                        relative[j] = r;
+                        if decoded.is_some() {
+                            motion.set_local_rotation(
+                                f,
+                                j,
+                                (relative[p].conjugate() * r).normalize(),
+                            );
+                        }
+                    }
+                    _ => {
+                        if let Some(q) = decoded {
+                            motion.set_local_rotation(f, j, q);
+                        }
+                    }
+                }
             }
         }
     }
@@ -412,6 +556,64 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn pelvis_frame_round_trips_and_ignores_the_heading() {
+        use crate::test_support::branching_motion;
+        let motion = branching_motion(30);
+        let mut turned = motion.clone();
+        for f in 0..turned.frame_count() {
+            // Turn the whole body about the vertical at the pelvis.
+            let yaw = Quat::from_rotation_y((70.0 + f as f32).to_radians());
+            let q = yaw * turned.local_rotation(f, 1);
+            turned.set_local_rotation(f, 1, q);
+        }
+        for repr in [Representation::Rot6d, Representation::ExpMap] {
+            let layout = FeatureLayout::new(motion.skeleton(), repr)
+                .unwrap()
+                .in_frame(RotationFrame::Pelvis)
+                .unwrap();
+            assert_eq!(layout.pelvis, 1);
+            assert_eq!(layout.joints, vec![0, 1, 2, 3, 5, 6]);
+            let features = layout.encode(&motion);
+            // Below the pelvis the features are P^-1 G_j.
+            let poses = forward_kinematics(&motion);
+            let c = layout.channels();
+            for f in [0, 17] {
+                let expected = poses.rotation(f, 1).conjugate() * poses.rotation(f, 6);
+                let got = layout.rotation(&features[f * c..(f + 1) * c], 5);
+                assert!(mocap_core::rotation::angle_between(expected, got) < 1e-3);
+            }
+            // Joints below the pelvis do not see the heading.
+            let turned_features = layout.encode(&turned);
+            let d = repr.dim();
+            for f in 0..motion.frame_count() {
+                for ch in 2 * d..c {
+                    let (a, b) = (features[f * c + ch], turned_features[f * c + ch]);
+                    assert!((a - b).abs() < 1e-4, "{repr:?} frame {f} channel {ch}");
+                }
+            }
+            // Decoding gives the local rotations back.
+            let mut back = turned.clone();
+            for f in 0..back.frame_count() {
+                for j in [2, 3, 5, 6] {
+                    back.set_local_rotation(f, j, Quat::IDENTITY);
+                }
+            }
+            layout.decode_into(&turned_features, &mut back);
+            for f in 0..motion.frame_count() {
+                for &j in &layout.joints {
+                    let angle = mocap_core::rotation::angle_between(
+                        turned.local_rotation(f, j),
+                        back.local_rotation(f, j),
+                    );
+                    assert!(angle.to_degrees() < 0.05, "{repr:?} frame {f} joint {j}");
+                }
+            }
+        }
+        let euler = FeatureLayout::new(motion.skeleton(), Representation::Euler).unwrap();
+        assert!(euler.in_frame(RotationFrame::Pelvis).is_err());
     }
 
     #[test]

@@ -25,7 +25,7 @@
 use burn::tensor::Tensor;
 use mocap_core::Skeleton;
 
-use crate::features::{FeatureLayout, Representation};
+use crate::features::{FeatureLayout, Representation, RotationFrame};
 use crate::{CleanError, Result};
 
 /// The skeleton the position loss runs forward kinematics on.
@@ -86,6 +86,12 @@ impl FkSkeleton {
             return Err(CleanError::Invalid(format!(
                 "the position loss needs 6D features, not {}",
                 layout.representation.name()
+            )));
+        }
+        if layout.frame != RotationFrame::Local {
+            return Err(CleanError::Invalid(format!(
+                "the position loss needs local rotations, not rotations in the {} frame",
+                layout.frame.name()
             )));
         }
         let mut feature = vec![None; skeleton.joint_count()];

@@ -111,7 +111,8 @@ impl CleanModel {
 
     /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
-        let layout = FeatureLayout::new(motion.skeleton(), self.description.representation)?;
+        let layout = FeatureLayout::new(motion.skeleton(), self.description.representation)?
+            .in_frame(self.description.frame)?;
         let c = layout.channels();
         if c != self.description.network.channels {
             return Err(CleanError::Invalid(format!(
@@ -303,6 +304,7 @@ mod tests {
         let description = ModelDescription {
             network,
             representation,
+            frame: Default::default(),
             joints: (0..joints).map(|j| format!("j{j}")).collect(),
             fps: 30.0,
         };

@@ -37,6 +37,17 @@
 //! noisy keypoints produces: wrong rotations that still put the joints near
 //! the observed points.
 //!
+//! Joints above the pelvis get no error (see
+//! [`RandomNoise::perturb_above_pelvis`]): some rigs put helper joints there
+//! (Bandai Namco's `joint_Root`, on the floor, 94 cm below `Hips`), which no
+//! keypoint detector sees. An error on such a joint turns the whole body
+//! about a point on the floor: the pelvis moves by `sigma` times the
+//! helper's 94 cm "bone" (8 cm at 5 degrees, three times the error of a
+//! body bone), and every joint below must swing to cancel it. Measured on
+//! `dataset-1_walk_tired_002` at `sigma` = 5 degrees, with that error the
+//! noisy local rotations err by 38 degrees at `Hips` and 53 at `UpperLeg`
+//! (the other joints 9-37); without it, see `bench/results/clean.md`.
+//!
 //! ## Spike noise ([`SpikeNoise`])
 //!
 //! A wrong association with another person: a random joint and every joint
@@ -63,6 +74,18 @@ pub struct RandomNoise {
     pub max_sigma_deg: f32,
     /// Correct the accumulation along the chain (default true).
     pub chain_corrected: bool,
+    /// Also perturb the joints above the pelvis
+    /// ([`mocap_core::Skeleton::first_branching_joint`]), such as a helper
+    /// root on the floor. Off by default (see the module docs); models
+    /// trained before this option existed were trained with it on, hence
+    /// the serde default.
+    #[serde(default = "perturbed_above_pelvis_before")]
+    pub perturb_above_pelvis: bool,
+}
+
+/// What noise headers written before `perturb_above_pelvis` existed mean.
+fn perturbed_above_pelvis_before() -> bool {
+    true
 }
 
 impl Default for RandomNoise {
@@ -70,6 +93,7 @@ impl Default for RandomNoise {
         RandomNoise {
             max_sigma_deg: 10.0,
             chain_corrected: true,
+            perturb_above_pelvis: false,
         }
     }
 }
@@ -146,16 +170,17 @@ pub fn add_random_noise<R: Rng + ?Sized>(
 ) -> (Motion, f32) {
     let sigma_deg = rng.random::<f32>() * params.max_sigma_deg.max(0.0);
     (
-        add_random_noise_sigma(motion, sigma_deg, params.chain_corrected, rng),
+        add_random_noise_sigma(motion, sigma_deg, params, rng),
         sigma_deg,
     )
 }
 
-/// Adds random noise of standard deviation `sigma_deg` degrees.
+/// Adds random noise of standard deviation `sigma_deg` degrees, corrected as
+/// `params` says (its `max_sigma_deg` is not used).
 pub fn add_random_noise_sigma<R: Rng + ?Sized>(
     motion: &Motion,
     sigma_deg: f32,
-    chain_corrected: bool,
+    params: &RandomNoise,
     rng: &mut R,
 ) -> Motion {
     let sigma = sigma_deg.to_radians();
@@ -166,10 +191,21 @@ pub fn add_random_noise_sigma<R: Rng + ?Sized>(
         .iter()
         .map(|j| j.channels.iter().any(|c| c.is_rotation()))
         .collect();
+    // Whether each joint gets its own error: not the joints above the pelvis
+    // unless asked (they come first: parents precede children).
+    let mut perturbed = rotates.clone();
+    if !params.perturb_above_pelvis {
+        let pelvis = skeleton.first_branching_joint();
+        let mut above = skeleton.joint(pelvis).parent;
+        while let Some(j) = above {
+            perturbed[j] = false;
+            above = skeleton.joint(j).parent;
+        }
+    }
     let mut out = motion.clone();
-    if !chain_corrected {
+    if !params.chain_corrected {
         for f in 0..motion.frame_count() {
-            for j in (0..n).filter(|&j| rotates[j]) {
+            for j in (0..n).filter(|&j| perturbed[j]) {
                 let q = motion.local_rotation(f, j) * random_rotation(rng, sigma);
                 out.set_local_rotation(f, j, q);
             }
@@ -203,8 +239,12 @@ pub fn add_random_noise_sigma<R: Rng + ?Sized>(
                 Some(p) => noisy_pos[p] + noisy_rot[p] * motion.local_translation(f, j),
                 None => x,
             };
-            let mut a = if rotates[j] {
+            let mut a = if perturbed[j] {
                 g * random_rotation(rng, sigma)
+            } else if rotates[j] {
+                // A helper above the pelvis keeps its rotation; its children
+                // are then where they should be and nothing swings.
+                g
             } else {
                 // A joint without rotation channels follows its parent.
                 match parent {
@@ -365,8 +405,17 @@ mod tests {
         // A straight chain of equal bones: naive noise grows with depth.
         let motion = synthetic_motion(400, 11);
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let naive = add_random_noise_sigma(&motion, 5.0, false, &mut rng);
-        let corrected = add_random_noise_sigma(&motion, 5.0, true, &mut rng);
+        // A chain has no pelvis (no branch): perturb every joint.
+        let corrected_params = RandomNoise {
+            perturb_above_pelvis: true,
+            ..Default::default()
+        };
+        let naive_params = RandomNoise {
+            chain_corrected: false,
+            ..corrected_params
+        };
+        let naive = add_random_noise_sigma(&motion, 5.0, &naive_params, &mut rng);
+        let corrected = add_random_noise_sigma(&motion, 5.0, &corrected_params, &mut rng);
         let en = position_errors(&motion, &naive);
         let ec = position_errors(&motion, &corrected);
         let last = en.len() - 1;
@@ -382,6 +431,32 @@ mod tests {
         for f in 0..motion.frame_count() {
             assert_eq!(motion.root_translation(f), corrected.root_translation(f));
         }
+    }
+
+    #[test]
+    fn joints_above_the_pelvis_keep_their_rotation_unless_asked() {
+        let motion = crate::test_support::branching_motion(50);
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let noisy = add_random_noise_sigma(&motion, 8.0, &RandomNoise::default(), &mut rng);
+        let moved = |noisy: &Motion, j: usize| {
+            (0..motion.frame_count())
+                .map(|f| {
+                    mocap_core::rotation::angle_between(
+                        motion.local_rotation(f, j),
+                        noisy.local_rotation(f, j),
+                    )
+                })
+                .fold(0.0f32, f32::max)
+        };
+        // Joint 0 (the helper root) is above the pelvis (joint 1).
+        assert!(moved(&noisy, 0) < 1e-5);
+        assert!(moved(&noisy, 1) > 1f32.to_radians());
+        let everywhere = RandomNoise {
+            perturb_above_pelvis: true,
+            ..Default::default()
+        };
+        let noisy = add_random_noise_sigma(&motion, 8.0, &everywhere, &mut rng);
+        assert!(moved(&noisy, 0) > 1f32.to_radians());
     }
 
     #[test]

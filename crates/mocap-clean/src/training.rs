@@ -29,7 +29,7 @@ use crate::dataset::{
     list_bvh, load_takes, paths_in_split, split_of, take_name, window, DataDescription, Split,
     SplitFractions, Take,
 };
-use crate::features::{FeatureLayout, Representation};
+use crate::features::{FeatureLayout, Representation, RotationFrame};
 use crate::fk::FkSkeleton;
 use crate::loss::{derivative_loss, position_loss, LossWeights};
 use crate::model::{Denoiser, DenoiserConfig};
@@ -49,6 +49,10 @@ const VALIDATION_SEED: u64 = 0x0005_eed0_fba1;
 pub struct ModelDescription {
     pub network: DenoiserConfig,
     pub representation: Representation,
+    /// Local rotations or rotations relative to the pelvis (models written
+    /// before this field existed are local).
+    #[serde(default)]
+    pub frame: RotationFrame,
     /// Names of the joints whose rotations are features, in order.
     pub joints: Vec<String>,
     /// Frame rate of the training data (the loss differences use it).
@@ -67,6 +71,9 @@ pub struct TrainOptions {
     /// Continue from the state folder when it holds a state.
     pub resume: bool,
     pub representation: Representation,
+    /// Which rotation of each joint the network sees.
+    #[serde(default)]
+    pub frame: RotationFrame,
     /// Network sizes; `channels` is set from the data.
     pub network: DenoiserConfig,
     pub epochs: usize,
@@ -105,6 +112,7 @@ impl Default for TrainOptions {
             state_dir: None,
             resume: false,
             representation: Representation::Rot6d,
+            frame: RotationFrame::Local,
             network: DenoiserConfig::small(0),
             epochs: 20,
             steps_per_epoch: 40,
@@ -297,7 +305,8 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .first()
         .ok_or_else(|| CleanError::Invalid("no training takes".into()))?;
     let fps = first.motion.fps() as f32;
-    let layout = FeatureLayout::new(first.motion.skeleton(), options.representation)?;
+    let layout = FeatureLayout::new(first.motion.skeleton(), options.representation)?
+        .in_frame(options.frame)?;
     let joints: Vec<String> = layout
         .joints
         .iter()
@@ -309,6 +318,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let description = ModelDescription {
         network,
         representation: options.representation,
+        frame: options.frame,
         joints,
         fps,
     };

@@ -243,6 +243,23 @@ impl Skeleton {
             .map(|(i, _)| i)
     }
 
+    /// The first joint, walking down from the first root, that has other
+    /// than exactly one child: the pelvis of a body (`Hips` in Bandai Namco
+    /// and CMU BVH, `root` in ASF), below any helper joints that some rigs
+    /// put above it (Bandai's `joint_Root` on the floor). Found from the
+    /// hierarchy alone, so it works for rigs with any joint names; a rig that
+    /// is a single chain gives its last joint.
+    pub fn first_branching_joint(&self) -> usize {
+        let mut joint = 0;
+        loop {
+            let mut children = self.children(joint);
+            match (children.next(), children.next()) {
+                (Some(only), None) => joint = only,
+                _ => return joint,
+            }
+        }
+    }
+
     /// `joint` and every joint below it, in skeleton order.
     pub fn subtree(&self, joint: usize) -> Vec<usize> {
         let mut inside = vec![false; self.joints.len()];

@@ -517,3 +517,24 @@ fn end_site_spellings_and_braces_on_the_same_line() {
         assert_eq!(motion.frame(0), [45.0]);
     }
 }
+
+#[test]
+fn the_first_branching_joint_is_the_pelvis_of_real_rigs() {
+    let name = |m: &Motion| {
+        let s = m.skeleton();
+        s.joint(s.first_branching_joint()).name.clone()
+    };
+    // Bandai: a helper `joint_Root` on the floor above `Hips`.
+    let bandai = read_bvh(&mocap_testdata::sample_walk()).unwrap();
+    assert_eq!(bandai.skeleton().joint(0).name, "joint_Root");
+    assert_eq!(name(&bandai), "Hips");
+    let Some(data) = shared_data() else { return };
+    let cases = data.join("parser-cases");
+    let mixamo = read_bvh(&cases.join("bvhpython_test_freebvh.bvh")).unwrap();
+    assert_eq!(name(&mixamo), "mixamorig:Hips");
+    let cmu = read_bvh(&cases.join("dme_example_crlf_leadingdot_frametime.bvh")).unwrap();
+    assert_eq!(name(&cmu), "Hips");
+    // A two-joint chain has no branch: its last joint.
+    let simple = read_bvh(&cases.join("bvhanim_test_simple.bvh")).unwrap();
+    assert_eq!(simple.skeleton().first_branching_joint(), 1);
+}

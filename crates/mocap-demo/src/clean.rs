@@ -12,7 +12,7 @@
 use mocap_clean::eval::{position_errors, rotation_error_deg};
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::add_random_noise_sigma;
+use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::angle_between;
 use mocap_core::Motion;
@@ -51,7 +51,12 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     let motion = read_bvh(&options.sample)?;
     let model = CleanModel::load(&options.clean_model, DeviceChoice::Cpu)?;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let noisy = add_random_noise_sigma(&motion, options.noise_sigma_deg, true, &mut rng);
+    let noisy = add_random_noise_sigma(
+        &motion,
+        options.noise_sigma_deg,
+        &RandomNoise::default(),
+        &mut rng,
+    );
     let started = std::time::Instant::now();
     let cleaned = model.clean(&noisy, None)?;
     let clean_seconds = started.elapsed().as_secs_f64();

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
-use mocap_clean::features::Representation;
+use mocap_clean::features::{Representation, RotationFrame};
 use mocap_clean::filters::Filter;
 use mocap_clean::infer::{clean_file, CleanOptions, Method};
 use mocap_clean::model::DenoiserConfig;
@@ -89,6 +89,10 @@ struct TrainArgs {
     /// rot6d, expmap or euler.
     #[arg(long)]
     representation: Option<Representation>,
+    /// Which rotation of each joint the network sees: `local` (relative to the parent, as in BVH) or
+    /// `pelvis` (relative to the pelvis; see bench/results/clean.md).
+    #[arg(long)]
+    rotations: Option<RotationFrame>,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -110,6 +114,10 @@ struct TrainArgs {
     /// Largest standard deviation of the random noise, degrees (report: 10).
     #[arg(long)]
     max_sigma: Option<f32>,
+    /// Also put random noise on the joints above the pelvis (helper joints such as Bandai's
+    /// `joint_Root` on the floor; off by default, see bench/results/clean.md).
+    #[arg(long)]
+    noise_above_pelvis: bool,
     /// Probability that a training window gets spikes.
     #[arg(long)]
     spike_probability: Option<f32>,
@@ -166,6 +174,10 @@ struct EvalArgs {
     /// Spike lengths (frames) of the spike-survival study, comma separated; `none` to skip.
     #[arg(long, value_name = "N,N,...")]
     spike_lengths: Option<String>,
+    /// Also put random noise on the joints above the pelvis (the noise of models trained before
+    /// this became the default; see bench/results/clean.md).
+    #[arg(long)]
+    noise_above_pelvis: bool,
     #[arg(long)]
     seed: Option<u64>,
     #[arg(long, default_value = "cpu")]
@@ -240,6 +252,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.learning_rate, a.lr);
     set(&mut o.seed, a.seed);
     set(&mut o.representation, a.representation);
+    set(&mut o.frame, a.rotations);
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
     set(&mut o.network.levels, a.levels);
@@ -248,6 +261,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.noise.spike_probability, a.spike_probability);
     if let Some(random) = o.noise.random.as_mut() {
         set(&mut random.max_sigma_deg, a.max_sigma);
+        random.perturb_above_pelvis |= a.noise_above_pelvis;
     }
     if let Some(spikes) = o.noise.spikes.as_mut() {
         set(&mut spikes.max_spikes, a.max_spikes);
@@ -279,6 +293,7 @@ fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
         device: a.device,
         ..EvalOptions::default()
     };
+    o.random.perturb_above_pelvis = a.noise_above_pelvis;
     if a.no_default_model {
         o.models.retain(|m| m.path.is_some());
     }
