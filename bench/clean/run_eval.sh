@@ -1,15 +1,18 @@
 #!/bin/bash
-# The evaluation table of bench/results/clean.md: every test take (116), filters tuned on 12 validation takes,
-# the shipped default model, the long-window model, and the 6-epoch MSE / derivative-loss runs of seed 1.
-# Then the speed benchmark of the default model.
+# The evaluation of bench/results/clean.md ("Evaluation on the 116 test takes"): noisy input, the four
+# classical filters (tuned on 12 validation takes per condition), the shipped model (trained by
+# bench/clean/base_filter.sh), the report's model without a base filter (bench/clean/plain_model.sh), the
+# model shipped before this session (trained on the earlier noise, for reference), each also followed by
+# spike finding (tuned per method), on every test take of ../shared/data/bandai; then the speed benchmark.
+# Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
 cd "$(dirname "$0")/../.."
 BIN=./target-clean/debug/examples
 DATA=../shared/data/bandai
-$BIN/clean_eval --data $DATA --tune-takes 12 \
-  --model "long-window model (T 64)=bench/clean/long-window.safetensors" \
-  --model "MSE, 6 epochs (seed 1)=bench/clean/compare/mse-seed1.safetensors" \
-  --model "derivative loss, 6 epochs (seed 1)=bench/clean/compare/derivative-seed1.safetensors" \
+PREVIOUS=bench/clean/default/previous-default.safetensors
+if [ ! -f $PREVIOUS ]; then mkdir -p bench/clean/default; git show 7ade215:models/clean-default.safetensors > $PREVIOUS; fi
+$BIN/clean_eval --data $DATA --tune-takes 12 --despike \
+  --model "plain model (no base filter)=bench/clean/plain/plain.safetensors" \
+  --model "previous model (earlier noise)=$PREVIOUS" \
   --json bench/clean/eval.json --markdown bench/clean/eval.md
 $BIN/clean_speed --data $DATA --frames 1800 --repeats 5 --train-steps 5 --batch 512 | tee bench/clean/speed.txt
-$BIN/clean_speed --data $DATA --model bench/clean/long-window.safetensors --frames 1800 --repeats 5 --train-steps 0 | tee -a bench/clean/speed.txt

@@ -23,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         method: Method::DefaultModel,
         device: Default::default(),
         hop: None,
+        despike: None,
     };
     let mut i = 2;
     while i < args.len() {

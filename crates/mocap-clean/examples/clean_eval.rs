@@ -2,7 +2,7 @@
 //!
 //! cargo run --release -p mocap-clean --example clean_eval -- --data ../shared/data/bandai \
 //!     [--model LABEL=FILE (LABEL without "=")]... [--no-default-model] [--no-filters] [--all-takes] \
-//!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] [--noise-above-pelvis] \
+//!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] [--noise-above-pelvis] [--despike] \
 //!     [--json OUT.json] [--markdown OUT.md]
 
 use std::path::PathBuf;
@@ -51,6 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     "--no-filters" => o.filters = false,
                     "--all-takes" => o.test_split_only = false,
                     "--noise-above-pelvis" => o.random.perturb_above_pelvis = true,
+                    "--despike" => o.despike = true,
                     other => return Err(format!("unknown option {other}").into()),
                 }
             }

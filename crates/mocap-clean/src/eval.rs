@@ -12,6 +12,12 @@
 //! Classical filters are tuned per noise condition on validation takes (grid
 //! search for the lowest rotation error) and then run on the evaluation
 //! takes with those settings.
+//!
+//! With [`EvalOptions::despike`], every method is also followed by spike
+//! finding ([`crate::despike`]; rows `METHOD + despike`, and `despike` alone
+//! on the noisy input), its threshold tuned per method the same way (on the
+//! spike condition). Spikes are looked for *after* the method: a denoiser
+//! removes the random noise that hides a spike's ends and leaves the spike.
 
 use std::path::PathBuf;
 
@@ -23,6 +29,7 @@ use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions, Take};
+use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::CleanModel;
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
@@ -82,6 +89,10 @@ pub struct EvalOptions {
     pub spikes: SpikeNoise,
     /// Spike lengths (frames) of the spike-survival study; empty to skip.
     pub spike_lengths: Vec<usize>,
+    /// Also follow every method by spike finding, tuned on the validation
+    /// takes (see the module docs).
+    #[serde(default)]
+    pub despike: bool,
     pub seed: u64,
     pub device: DeviceChoice,
 }
@@ -102,6 +113,7 @@ impl Default for EvalOptions {
             random: RandomNoise::default(),
             spikes: SpikeNoise::default(),
             spike_lengths: vec![2, 4, 8, 16, 32, 64],
+            despike: false,
             seed: 7,
             device: DeviceChoice::Cpu,
         }
@@ -136,6 +148,11 @@ pub struct EvalReport {
     /// One entry per method and condition.
     pub entries: Vec<MethodMetrics>,
     pub tuned_filters: Vec<TunedFilter>,
+    /// The spike finding settings chosen on the validation takes for each
+    /// method (`METHOD + despike`), with the mean rotation error they gave
+    /// there (spike condition), when asked.
+    #[serde(default)]
+    pub tuned_despike: Vec<(String, DespikeOptions, f64)>,
     pub spike_survival: Vec<SpikeSurvival>,
 }
 
@@ -222,9 +239,49 @@ fn tune(
     })
 }
 
+/// Spike-finding thresholds and spans tried when tuning.
+const DESPIKE_THRESHOLDS: [f32; 7] = [2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
+const DESPIKE_SPANS: [usize; 3] = [1, 2, 3];
+
+/// The spike-finding settings that give the lowest mean rotation error
+/// when run on `cleaner`'s output of the tuning takes (spike condition).
+fn tune_despike(
+    takes: &[Take],
+    cleaner: &Cleaner,
+    options: &EvalOptions,
+) -> Result<(DespikeOptions, f64)> {
+    let cleaned: Vec<Motion> = (0..takes.len())
+        .map(|i| cleaner.run(&make_noisy(takes, i, 1, options)?))
+        .collect::<Result<_>>()?;
+    let mut best: Option<(f64, DespikeOptions)> = None;
+    let grid = DESPIKE_SPANS
+        .iter()
+        .flat_map(|&span| DESPIKE_THRESHOLDS.map(|threshold| (span, threshold)));
+    for (span, threshold) in grid {
+        let despike = DespikeOptions {
+            threshold,
+            span,
+            ..DespikeOptions::default()
+        };
+        let sum: f64 = takes
+            .iter()
+            .zip(&cleaned)
+            .map(|(take, m)| rotation_error_deg(&take.motion, &remove_spikes(m, &despike).0))
+            .sum();
+        let mean = sum / takes.len().max(1) as f64;
+        if best.is_none_or(|(b, _)| mean < b) {
+            best = Some((mean, despike));
+        }
+    }
+    let (error, despike) = best.expect("thresholds to try");
+    Ok((despike, error))
+}
+
 enum Cleaner {
     Filter(Filter),
     Model(Box<CleanModel>),
+    /// The input unchanged (for `despike` alone).
+    Nothing,
 }
 
 impl Cleaner {
@@ -232,8 +289,73 @@ impl Cleaner {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
             Cleaner::Model(m) => m.clean(noisy, None),
+            Cleaner::Nothing => Ok(noisy.clone()),
         }
     }
+}
+
+/// A method of the evaluation: a cleaner, followed by spike finding or not.
+struct Method<'a> {
+    label: String,
+    cleaner: &'a Cleaner,
+    despike: Option<DespikeOptions>,
+}
+
+impl Method<'_> {
+    fn run(&self, noisy: &Motion) -> Result<Motion> {
+        let cleaned = self.cleaner.run(noisy)?;
+        Ok(match &self.despike {
+            Some(d) => remove_spikes(&cleaned, d).0,
+            None => cleaned,
+        })
+    }
+}
+
+/// The input unchanged, the cleaner of the `despike` row.
+static NOTHING: Cleaner = Cleaner::Nothing;
+
+/// The methods: `cleaners` as they are, then (when spike finding is asked)
+/// spike finding alone and every cleaner followed by it, with thresholds
+/// tuned per method on `tune_takes` (remembered by label in `tuned`).
+fn methods<'a>(
+    cleaners: &[&'a (String, Cleaner)],
+    options: &EvalOptions,
+    tune_takes: &[Take],
+    tuned: &mut Vec<(String, DespikeOptions, f64)>,
+) -> Result<Vec<Method<'a>>> {
+    let mut out: Vec<Method<'a>> = cleaners
+        .iter()
+        .map(|(label, cleaner)| Method {
+            label: label.clone(),
+            cleaner,
+            despike: None,
+        })
+        .collect();
+    if !options.despike {
+        return Ok(out);
+    }
+    let alone = ("despike".to_string(), &NOTHING);
+    let with_despike = std::iter::once(alone).chain(
+        cleaners
+            .iter()
+            .map(|(label, cleaner)| (format!("{label} + despike"), cleaner)),
+    );
+    for (label, cleaner) in with_despike {
+        let despike = match tuned.iter().find(|(l, _, _)| *l == label) {
+            Some((_, d, _)) => *d,
+            None => {
+                let (d, error) = tune_despike(tune_takes, cleaner, options)?;
+                tuned.push((label.clone(), d, error));
+                d
+            }
+        };
+        out.push(Method {
+            label,
+            cleaner,
+            despike: Some(despike),
+        });
+    }
+    Ok(out)
 }
 
 /// Runs the evaluation.
@@ -266,7 +388,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     }
     let mut tuned_filters = Vec::new();
     let mut per_condition: Vec<Vec<(String, Cleaner)>> = Vec::new();
-    let tune_takes = if options.filters {
+    let tune_takes = if options.filters || options.despike {
         load_takes(&tune_paths[..options.tune_takes.min(tune_paths.len())])?
     } else {
         Vec::new()
@@ -282,14 +404,17 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         }
         per_condition.push(cleaners);
     }
+    if options.despike && tune_takes.len() < 2 {
+        return Err(CleanError::Invalid(
+            "tuning spike finding needs at least two validation takes".into(),
+        ));
+    }
+    let mut tuned_despike = Vec::new();
 
     let mut entries = Vec::new();
     for (condition, filters) in per_condition.iter().enumerate() {
-        let methods: Vec<(&str, &Cleaner)> = filters
-            .iter()
-            .chain(models.iter())
-            .map(|(l, c)| (l.as_str(), c))
-            .collect();
+        let cleaners: Vec<_> = filters.iter().chain(models.iter()).collect();
+        let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
         let mut frames_total = 0usize;
         let bar = mocap_nn::train::work_bar(
@@ -309,13 +434,13 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 sums[slot][2] += a * w;
             };
             add(0, &noisy);
-            for (k, (_, cleaner)) in methods.iter().enumerate() {
-                add(k + 1, &cleaner.run(&noisy)?);
+            for (k, method) in methods.iter().enumerate() {
+                add(k + 1, &method.run(&noisy)?);
             }
             bar.inc(1);
         }
         bar.finish_and_clear();
-        let names = std::iter::once("noisy input").chain(methods.iter().map(|(l, _)| *l));
+        let names = std::iter::once("noisy input").chain(methods.iter().map(|m| m.label.as_str()));
         for (name, s) in names.zip(&sums) {
             let n = frames_total.max(1) as f64;
             entries.push(MethodMetrics {
@@ -331,13 +456,13 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     // Spike survival: one spike of each length in the middle of each take
     // (no random noise), error measured on the spiked joints and frames.
     let mut spike_survival = Vec::new();
-    let spike_methods: Vec<(&str, &Cleaner)> = per_condition
+    let cleaners: Vec<_> = per_condition
         .get(1)
         .into_iter()
         .flatten()
         .chain(models.iter())
-        .map(|(l, c)| (l.as_str(), c))
         .collect();
+    let spike_methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
     for &length in &options.spike_lengths {
         let mut noisy_sum = 0.0;
         let mut residual = vec![0.0; spike_methods.len()];
@@ -372,18 +497,18 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 e / (s.frames * joints.len()) as f64
             };
             noisy_sum += region(&noisy);
-            for (k, (_, cleaner)) in spike_methods.iter().enumerate() {
-                residual[k] += region(&cleaner.run(&noisy)?);
+            for (k, method) in spike_methods.iter().enumerate() {
+                residual[k] += region(&method.run(&noisy)?);
             }
             count += 1;
         }
         if count == 0 {
             continue;
         }
-        for (k, (label, _)) in spike_methods.iter().enumerate() {
+        for (k, method) in spike_methods.iter().enumerate() {
             spike_survival.push(SpikeSurvival {
                 length,
-                method: label.to_string(),
+                method: method.label.clone(),
                 noisy_error_deg: noisy_sum / count as f64,
                 residual_error_deg: residual[k] / count as f64,
             });
@@ -395,6 +520,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         frames: takes.iter().map(|t| t.motion.frame_count()).sum(),
         entries,
         tuned_filters,
+        tuned_despike,
         spike_survival,
     })
 }
@@ -403,6 +529,18 @@ impl EvalReport {
     /// The report as Markdown tables.
     pub fn to_markdown(&self) -> String {
         let mut s = format!("{} takes, {} frames.\n\n", self.takes, self.frames);
+        if !self.tuned_despike.is_empty() {
+            s += "Spike finding tuned on the validation takes (spike condition):\n\n\
+                  | method | threshold | span (frames) | longest spike (frames) | rotation error there (deg) |\n\
+                  | --- | ---: | ---: | ---: | ---: |\n";
+            for (label, d, error) in &self.tuned_despike {
+                s += &format!(
+                    "| {label} | {} | {} | {} | {error:.3} |\n",
+                    d.threshold, d.span, d.max_frames
+                );
+            }
+            s += "\n";
+        }
         for condition in CONDITIONS {
             s += &format!("### Noise: {condition}\n\n| method | rotation error (deg) | position error (cm) | acceleration error (cm/frame^2) |\n| --- | ---: | ---: | ---: |\n");
             for e in self.entries.iter().filter(|e| e.condition == condition) {

@@ -222,22 +222,27 @@ pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
     let fps = motion.fps() as f32;
     filter.validate(fps)?;
     let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
-    let c = layout.channels();
-    let frames = motion.frame_count();
     let mut features = layout.encode(motion);
-    let mut track = vec![0.0; frames];
-    for ch in 0..c {
-        for f in 0..frames {
-            track[f] = features[f * c + ch];
-        }
-        filter.apply_track(&mut track, fps);
-        for f in 0..frames {
-            features[f * c + ch] = track[f];
-        }
-    }
+    filter_features(&mut features, layout.channels(), filter, fps);
     let mut out = motion.clone();
     layout.decode_into(&features, &mut out);
     Ok(out)
+}
+
+/// Filters every channel of `features` (frame after frame, `channels` per
+/// frame) along time.
+pub fn filter_features(features: &mut [f32], channels: usize, filter: &Filter, fps: f32) {
+    let frames = features.len() / channels.max(1);
+    let mut track = vec![0.0; frames];
+    for ch in 0..channels {
+        for f in 0..frames {
+            track[f] = features[f * channels + ch];
+        }
+        filter.apply_track(&mut track, fps);
+        for f in 0..frames {
+            features[f * channels + ch] = track[f];
+        }
+    }
 }
 
 fn butterworth(track: &mut [f32], order: usize, cutoff_hz: f32, fps: f32) {

@@ -23,8 +23,9 @@ use mocap_nn::checkpoint::{header_from_bytes, load_weights_from_bytes};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
+use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::FeatureLayout;
-use crate::filters::{filter_motion, Filter};
+use crate::filters::{filter_features, filter_motion, Filter};
 use crate::model::Denoiser;
 use crate::training::{ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
 use crate::{CleanError, Result};
@@ -157,10 +158,23 @@ impl CleanModel {
             let n = batch.min(windows - start_index);
             let mut x = vec![0.0; n * c * t];
             let mut offsets = Vec::with_capacity(n);
+            // Per window, base(x) - x (see `ModelDescription::base_filter`).
+            let mut base_corrections = Vec::new();
             for b in 0..n {
                 let s = (start_index + b) * hop;
                 let mut w = padded[s * c..(s + t) * c].to_vec();
                 offsets.push(layout.recenter(&mut w));
+                if let Some(filter) = &self.description.base_filter {
+                    let mut filtered = w.clone();
+                    filter_features(&mut filtered, c, filter, self.description.fps);
+                    base_corrections.push(
+                        filtered
+                            .iter()
+                            .zip(&w)
+                            .map(|(f, x)| f - x)
+                            .collect::<Vec<f32>>(),
+                    );
+                }
                 for f in 0..t {
                     for ch in 0..c {
                         x[(b * c + ch) * t + f] = w[f * c + ch];
@@ -177,6 +191,11 @@ impl CleanModel {
                 for f in 0..t {
                     for ch in 0..c {
                         out_window[f * c + ch] = y[(b * c + ch) * t + f];
+                    }
+                }
+                if let Some(correction) = base_corrections.get(b) {
+                    for (o, d) in out_window.iter_mut().zip(correction) {
+                        *o += d;
                     }
                 }
                 // Back on the take's branch before blending.
@@ -230,6 +249,9 @@ pub struct CleanOptions {
     pub device: DeviceChoice,
     /// Frames between window starts (default: a quarter window).
     pub hop: Option<usize>,
+    /// Look for spikes after cleaning and bridge them ([`crate::despike`]).
+    #[serde(default)]
+    pub despike: Option<DespikeOptions>,
 }
 
 /// What `mocap clean IN -o OUT` reports.
@@ -244,6 +266,9 @@ pub struct CleanReport {
     pub frames_per_second: f64,
     /// Mean change of the joint rotations, in degrees.
     pub mean_change_deg: f64,
+    /// The spikes found and bridged (with `despike`).
+    #[serde(default)]
+    pub spikes: Vec<FoundSpike>,
 }
 
 /// Reads a take, cleans it and writes it (atomically).
@@ -274,6 +299,10 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             )
         }
     };
+    let (cleaned, spikes) = match &options.despike {
+        Some(despike) => remove_spikes(&cleaned, despike),
+        None => (cleaned, Vec::new()),
+    };
     write_bvh(&options.output, &cleaned)?;
     let frames = motion.frame_count();
     Ok(CleanReport {
@@ -284,6 +313,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         seconds,
         frames_per_second: frames as f64 / seconds.max(1e-9),
         mean_change_deg: crate::eval::rotation_error_deg(&motion, &cleaned),
+        spikes,
     })
 }
 
@@ -307,6 +337,7 @@ mod tests {
             frame: Default::default(),
             joints: (0..joints).map(|j| format!("j{j}")).collect(),
             fps: 30.0,
+            base_filter: None,
         };
         let header = CheckpointHeader {
             kind: CHECKPOINT_KIND.into(),

@@ -13,6 +13,8 @@
 //!
 //! - [`noise`]: the two noise models (chain-corrected random noise, spikes);
 //! - [`features`]: rotation representations fed to the network;
+//! - [`despike`]: finding spikes by the jumps at their ends and bridging
+//!   them, a classical stage before a denoiser;
 //! - [`filters`]: classical baselines (zero-phase Butterworth,
 //!   Savitzky-Golay, median, One Euro);
 //! - [`dataset`]: BVH takes split by take, windows;
@@ -28,6 +30,7 @@
 //! [`eval::EvalOptions`], whose reports serialise to JSON.
 
 pub mod dataset;
+pub mod despike;
 pub mod eval;
 pub mod features;
 pub mod filters;

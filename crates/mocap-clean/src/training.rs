@@ -30,6 +30,7 @@ use crate::dataset::{
     SplitFractions, Take,
 };
 use crate::features::{FeatureLayout, Representation, RotationFrame};
+use crate::filters::{filter_features, Filter};
 use crate::fk::FkSkeleton;
 use crate::loss::{derivative_loss, position_loss, LossWeights};
 use crate::model::{Denoiser, DenoiserConfig};
@@ -57,6 +58,14 @@ pub struct ModelDescription {
     pub joints: Vec<String>,
     /// Frame rate of the training data (the loss differences use it).
     pub fps: f32,
+    /// A classical filter the network's correction is added to: the model's
+    /// output is `base(x) + (N(x) - x)` instead of `N(x)` (`N` has a global
+    /// skip, so `N(x) - x` is its correction). At the start of training the
+    /// correction is near zero and the model is as good as the filter;
+    /// training learns what the filter gets wrong. Filtered per window, in
+    /// training and in use alike. `None`: the report's model.
+    #[serde(default)]
+    pub base_filter: Option<Filter>,
 }
 
 /// Options of `mocap clean train`.
@@ -74,6 +83,9 @@ pub struct TrainOptions {
     /// Which rotation of each joint the network sees.
     #[serde(default)]
     pub frame: RotationFrame,
+    /// See [`ModelDescription::base_filter`].
+    #[serde(default)]
+    pub base_filter: Option<Filter>,
     /// Network sizes; `channels` is set from the data.
     pub network: DenoiserConfig,
     pub epochs: usize,
@@ -113,6 +125,7 @@ impl Default for TrainOptions {
             resume: false,
             representation: Representation::Rot6d,
             frame: RotationFrame::Local,
+            base_filter: None,
             network: DenoiserConfig::small(0),
             epochs: 20,
             steps_per_epoch: 40,
@@ -163,6 +176,9 @@ pub struct WindowSampler<'a> {
     layout: &'a FeatureLayout,
     frames: usize,
     noise: NoiseConfig,
+    /// The base filter of the model and the frame rate (see
+    /// [`ModelDescription::base_filter`]).
+    base: Option<(Filter, f32)>,
 }
 
 impl<'a> WindowSampler<'a> {
@@ -195,7 +211,15 @@ impl<'a> WindowSampler<'a> {
             layout,
             frames,
             noise,
+            base: None,
         })
+    }
+
+    /// Targets for a model whose output is added to `base` run on its
+    /// input (see [`ModelDescription::base_filter`]).
+    pub fn with_base_filter(mut self, base: Option<Filter>, fps: f32) -> Self {
+        self.base = base.map(|f| (f, fps));
+        self
     }
 
     fn pick<R: Rng + ?Sized>(&self, rng: &mut R) -> (usize, usize) {
@@ -245,6 +269,15 @@ impl<'a> WindowSampler<'a> {
                 // the same way (see `FeatureLayout::align_target`).
                 self.layout.align_target(&xf, &mut yf);
                 self.layout.recenter(&mut xf).apply(&mut yf);
+                if let Some((filter, fps)) = &self.base {
+                    // The network's output N(x) stands for y - base(x) + x,
+                    // so that the model's output N(x) - x + base(x) is y.
+                    let mut filtered = xf.clone();
+                    filter_features(&mut filtered, c, filter, *fps);
+                    for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&filtered) {
+                        *y += x - b;
+                    }
+                }
                 Ok((xf, yf))
             })
             .collect::<Result<Vec<_>>>()?;
@@ -321,6 +354,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         frame: options.frame,
         joints,
         fps,
+        base_filter: options.base_filter,
     };
     let loss = if options.derivative_loss {
         LossWeights::derivative(fps)
@@ -352,13 +386,20 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         held_out,
     };
 
+    if options.position_weight > 0.0 && options.base_filter.is_some() {
+        return Err(CleanError::Invalid(
+            "the position term and a base filter do not go together (the term reads the network's output as rotations)".into(),
+        ));
+    }
     let fk = if options.position_weight > 0.0 {
         Some(FkSkeleton::new(first.motion.skeleton(), &layout)?)
     } else {
         None
     };
-    let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?;
-    let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?;
+    let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
+        .with_base_filter(options.base_filter, fps);
+    let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
+        .with_base_filter(options.base_filter, fps);
     let shape = [options.batch_size, network.channels, network.window];
     let mut valid_rng = ChaCha8Rng::seed_from_u64(VALIDATION_SEED);
     let valid_batches = (0..options
@@ -525,6 +566,10 @@ mod tests {
     use crate::test_support::synthetic_motion_phase;
     use mocap_core::io::bvh::write_bvh;
 
+    /// Training seeds the device's global generator: runs in parallel tests
+    /// would draw from it in turn and lose their reproducibility.
+    static ONE_RUN_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
     /// A folder of small synthetic takes and options for a tiny run.
     fn tiny_setup(dir: &Path) -> TrainOptions {
         let data = dir.join("data");
@@ -557,6 +602,7 @@ mod tests {
 
     #[test]
     fn a_resumed_run_matches_an_uninterrupted_one() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();
         let base = tiny_setup(dir.path());
         let straight = TrainOptions {
@@ -589,5 +635,71 @@ mod tests {
         assert_eq!(header.kind, CHECKPOINT_KIND);
         assert_eq!(header.data["data"]["train_takes"], b.data.train_takes);
         assert!(b.plot.is_file());
+    }
+
+    #[test]
+    fn a_base_filter_moves_the_target_by_what_the_filter_changes() {
+        let takes: Vec<Take> = (0..3)
+            .map(|i| Take {
+                name: format!("take_{i}"),
+                path: PathBuf::new(),
+                motion: synthetic_motion_phase(40, 4, i as f32),
+            })
+            .collect();
+        let layout = FeatureLayout::new(takes[0].motion.skeleton(), Representation::Rot6d).unwrap();
+        let filter = Filter::Butterworth {
+            order: 2,
+            cutoff_hz: 2.0,
+        };
+        let plain = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default()).unwrap();
+        let based = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default())
+            .unwrap()
+            .with_base_filter(Some(filter), 30.0);
+        let (x1, y1) = plain.batch(&mut ChaCha8Rng::seed_from_u64(1), 4).unwrap();
+        let (x2, y2) = based.batch(&mut ChaCha8Rng::seed_from_u64(1), 4).unwrap();
+        assert_eq!(x1, x2);
+        let (c, t) = (layout.channels(), 16);
+        let mut moved = 0.0f32;
+        for b in 0..4 {
+            // The batch is [sample, channel, frame]; filters take frames.
+            let frame_major = |v: &[f32]| -> Vec<f32> {
+                (0..t)
+                    .flat_map(|f| (0..c).map(move |ch| (f, ch)))
+                    .map(|(f, ch)| v[(b * c + ch) * t + f])
+                    .collect()
+            };
+            let x = frame_major(&x1);
+            let mut filtered = x.clone();
+            filter_features(&mut filtered, c, &filter, 30.0);
+            let (plain_y, based_y) = (frame_major(&y1), frame_major(&y2));
+            for i in 0..x.len() {
+                let expected = plain_y[i] + x[i] - filtered[i];
+                assert!((based_y[i] - expected).abs() < 1e-5);
+                moved = moved.max((based_y[i] - plain_y[i]).abs());
+            }
+        }
+        // The filter did change the noisy windows.
+        assert!(moved > 1e-3);
+    }
+
+    #[test]
+    fn a_model_with_a_base_filter_trains_and_cleans() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let options = TrainOptions {
+            out: dir.path().join("based.safetensors"),
+            base_filter: Some(Filter::SavitzkyGolay {
+                window: 5,
+                polyorder: 2,
+            }),
+            ..tiny_setup(dir.path())
+        };
+        let report = train(&options).unwrap();
+        let model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        assert_eq!(model.description.base_filter, options.base_filter);
+        let motion = synthetic_motion_phase(50, 4, 0.5);
+        let cleaned = model.clean(&motion, None).unwrap();
+        assert!(cleaned.values().iter().all(|v| v.is_finite()));
+        assert_eq!(cleaned.frame_count(), 50);
     }
 }

@@ -164,3 +164,57 @@ fn the_shipped_model_cleans_a_held_out_take() {
     );
     assert!(after < 0.6 * before, "{before} -> {after}");
 }
+
+#[test]
+fn a_long_spike_in_a_real_take_is_found_and_bridged() {
+    use mocap_clean::despike::{remove_spikes, DespikeOptions};
+    use mocap_clean::noise::{add_spikes, Spike};
+    let (Some(motion), Some(donor)) = (
+        take("dataset-1_walk_normal_001.bvh"),
+        take("dataset-1_dance-short_normal_001.bvh"),
+    ) else {
+        return;
+    };
+    assert!(donor.frame_count() >= motion.frame_count());
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut spikes = [Spike {
+        joint: 0,
+        start: 40,
+        frames: 32,
+    }];
+    let (spiked, spikes) = add_spikes(
+        &motion,
+        &[&donor],
+        &SpikeNoise::default(),
+        &mut spikes,
+        &mut rng,
+    )
+    .unwrap();
+    let s = spikes[0];
+    let subtree = motion.skeleton().subtree(s.joint);
+    let error = |m: &Motion| -> f32 {
+        let mut sum = 0.0;
+        for f in s.start..s.start + s.frames {
+            for &j in &subtree {
+                sum += mocap_core::rotation::angle_between(
+                    motion.local_rotation(f, j),
+                    m.local_rotation(f, j),
+                );
+            }
+        }
+        sum.to_degrees() / (s.frames * subtree.len()) as f32
+    };
+    let (repaired, found) = remove_spikes(&spiked, &DespikeOptions::default());
+    eprintln!(
+        "spike at {} frames {}..{}: {:.1} -> {:.1} degrees; found {found:?}",
+        motion.skeleton().joint(s.joint).name,
+        s.start,
+        s.start + s.frames,
+        error(&spiked),
+        error(&repaired)
+    );
+    // That spike and nothing else (the walk itself has none).
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!((found[0].start, found[0].frames), (s.start, s.frames));
+    assert!(error(&repaired) < 0.5 * error(&spiked));
+}

@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context};
+use mocap_clean::despike::DespikeOptions;
 use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
 use mocap_clean::features::{Representation, RotationFrame};
 use mocap_clean::filters::Filter;
@@ -30,7 +31,7 @@ pub struct Args {
 #[derive(clap::Subcommand)]
 enum CleanCommand {
     /// Train a denoiser on clean takes with synthetic markerless noise.
-    Train(TrainArgs),
+    Train(Box<TrainArgs>),
     /// Noisy input, tuned filters and models on held-out takes: rotation, position and acceleration errors.
     Eval(EvalArgs),
 }
@@ -57,6 +58,16 @@ struct TakeArgs {
     /// Frames between window starts (default: a quarter window).
     #[arg(long)]
     hop: Option<usize>,
+    /// After cleaning, find spikes (a joint and its subtree jumping away and back) and bridge them;
+    /// see bench/results/clean.md for what it gains and costs.
+    #[arg(long)]
+    despike: bool,
+    /// Spike finding: a boundary is a subtree jump this many times the joints' median jump.
+    #[arg(long, requires = "despike")]
+    despike_threshold: Option<f32>,
+    /// Spike finding: frames averaged on each side of a boundary.
+    #[arg(long, requires = "despike")]
+    despike_span: Option<usize>,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
@@ -93,6 +104,10 @@ struct TrainArgs {
     /// `pelvis` (relative to the pelvis; see bench/results/clean.md).
     #[arg(long)]
     rotations: Option<RotationFrame>,
+    /// A classical filter (same SPEC as `mocap clean --filter`) whose output the network corrects,
+    /// instead of correcting its input (see bench/results/clean.md).
+    #[arg(long, value_name = "SPEC")]
+    base_filter: Option<Filter>,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -162,6 +177,9 @@ struct EvalArgs {
     /// Leave out the classical filters.
     #[arg(long)]
     no_filters: bool,
+    /// Also follow every method by spike finding (tuned per method on validation takes).
+    #[arg(long)]
+    despike: bool,
     /// Evaluate every take, not only the test split (for data the models were not trained on).
     #[arg(long)]
     all_takes: bool,
@@ -192,7 +210,7 @@ struct EvalArgs {
 
 pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     match args.command {
-        Some(CleanCommand::Train(a)) => run_train(a, options),
+        Some(CleanCommand::Train(a)) => run_train(*a, options),
         Some(CleanCommand::Eval(a)) => run_eval(a),
         None => run_clean(args.take, options),
     }
@@ -209,12 +227,19 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         (None, Some(filter)) => Method::Filter(filter),
         (None, None) => Method::DefaultModel,
     };
+    let despike = a.despike.then(|| {
+        let mut d = DespikeOptions::default();
+        set(&mut d.threshold, a.despike_threshold);
+        set(&mut d.span, a.despike_span);
+        d
+    });
     let report = clean_file(&CleanOptions {
         input,
         output,
         method,
         device: a.device,
         hop: a.hop,
+        despike,
     })?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -227,6 +252,9 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.mean_change_deg,
             report.frames_per_second
         );
+        if a.despike {
+            eprintln!("bridged {} spikes", report.spikes.len());
+        }
     }
     Ok(())
 }
@@ -253,6 +281,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.seed, a.seed);
     set(&mut o.representation, a.representation);
     set(&mut o.frame, a.rotations);
+    o.base_filter = a.base_filter;
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
     set(&mut o.network.levels, a.levels);
@@ -294,6 +323,7 @@ fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
         ..EvalOptions::default()
     };
     o.random.perturb_above_pelvis = a.noise_above_pelvis;
+    o.despike = a.despike;
     if a.no_default_model {
         o.models.retain(|m| m.path.is_some());
     }

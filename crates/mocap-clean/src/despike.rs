@@ -1,0 +1,318 @@
+//! Finding and bridging spikes: a classical stage run before a denoiser.
+//!
+//! A spike of markerless capture (a wrong association with another person,
+//! [`crate::noise::SpikeNoise`]) gives a joint and every joint below it the
+//! rotations of another motion for a while. Inside the spike the motion is
+//! smooth and plausible, so a denoiser that sees a short window cannot tell
+//! it from the truth once the spike is longer than its window; what gives a
+//! spike away is its two ends, where the whole subtree jumps at once.
+//!
+//! [`find_spikes`] looks for those jumps:
+//!
+//! 1. the jump of joint `k` at frame `t` is the angle between its mean local
+//!    rotation over the [`DespikeOptions::span`] frames before `t` and over
+//!    the `span` frames from `t` on (with a span of 1: frames `t - 1` and
+//!    `t`; longer spans average out per-frame noise and see the ends of a
+//!    spike that a denoiser has blurred), divided by the upper quartile of that
+//!    joint's jumps over the take (so fast joints and noisy takes are judged by
+//!    their own scale);
+//! 2. the jump of a subtree is the median of its joints' jumps: a spike
+//!    moves (nearly) all of them at once, a noisy joint alone does not;
+//! 3. a joint whose own jump and whose subtree's jump both exceed
+//!    [`DespikeOptions::threshold`], while no joint above it does, is at a
+//!    *boundary* of a spike, where its subtree's jump is the largest within
+//!    `span - 1` frames. The root never is, nor a joint with no rotating
+//!    joint below it (its own jump is all there is to go by: a toe that
+//!    rests and then moves would do);
+//! 4. boundaries of the same joint are paired in time order, the first
+//!    opening and the second closing a spike, when they lie at most
+//!    [`DespikeOptions::max_frames`] apart (intermittent spikes give several
+//!    pairs); a boundary without a partner is left alone.
+//!
+//! [`remove_spikes`] then replaces each found spike's subtree rotations by
+//! the spherical interpolation (slerp) between the last frame before and the
+//! first frame after it. Long spikes are bridged with a straight path, which
+//! loses whatever the joint really did meanwhile, but it is much closer than
+//! another person's motion.
+
+use mocap_core::rotation::{angle_between, slerp, Quat};
+use mocap_core::Motion;
+use serde::{Deserialize, Serialize};
+
+/// Settings of spike finding.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DespikeOptions {
+    /// A subtree's median jump, in multiples of each joint's median jump,
+    /// above which a frame is a spike boundary.
+    pub threshold: f32,
+    /// Longest spike looked for, in frames.
+    pub max_frames: usize,
+    /// Frames averaged on each side of a boundary (at least 1).
+    pub span: usize,
+}
+
+impl Default for DespikeOptions {
+    fn default() -> Self {
+        // Tuned on 12 validation takes of the Bandai data with random noise
+        // and spikes (`mocap clean eval --despike`, bench/results/clean.md).
+        DespikeOptions {
+            threshold: 3.0,
+            max_frames: 90,
+            span: 2,
+        }
+    }
+}
+
+/// The mean of unit quaternions that lie close together (sign-aligned to
+/// the first, summed, normalised).
+fn mean_rotation(rotations: impl Iterator<Item = Quat>) -> Quat {
+    let mut sum = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+    let mut first: Option<Quat> = None;
+    for q in rotations {
+        let reference = *first.get_or_insert(q);
+        sum += if q.dot(reference) < 0.0 { -q } else { q };
+    }
+    sum.normalize()
+}
+
+/// A spike that was found: `joint` and its subtree, frames
+/// `start..start + frames`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FoundSpike {
+    pub joint: usize,
+    pub start: usize,
+    pub frames: usize,
+}
+
+/// The spikes of `motion` (see the module docs), in order of joint, then
+/// start.
+pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike> {
+    let skeleton = motion.skeleton();
+    let frames = motion.frame_count();
+    let n = skeleton.joint_count();
+    let span = options.span.max(1);
+    if frames < 2 * span + 1 {
+        return Vec::new();
+    }
+    // Boundaries at frames `first..=last` (both sides have `span` frames).
+    let (first, last) = (span, frames - span);
+    let rotates: Vec<bool> = skeleton
+        .joints()
+        .iter()
+        .map(|j| j.has_rotation_channels())
+        .collect();
+    // Jumps, in multiples of each joint's median jump; jump[t * n + k] is
+    // between frames t - 1 and t (t < first unused).
+    let mut jump = vec![0.0f32; frames * n];
+    for k in (0..n).filter(|&k| rotates[k]) {
+        let mut angles: Vec<f32> = (first..=last)
+            .map(|t| {
+                let before = mean_rotation((t - span..t).map(|f| motion.local_rotation(f, k)));
+                let after = mean_rotation((t..t + span).map(|f| motion.local_rotation(f, k)));
+                angle_between(before, after).to_degrees()
+            })
+            .collect();
+        for (i, a) in angles.iter().enumerate() {
+            jump[(first + i) * n + k] = *a;
+        }
+        // The scale: the upper quartile of the joint's jumps (at least one
+        // degree). Not the median: joints that rest most of the time (toes
+        // in a walk) would make every step look like a spike.
+        angles.sort_by(f32::total_cmp);
+        let scale = angles[angles.len() * 3 / 4].max(1.0);
+        for t in first..=last {
+            jump[t * n + k] /= scale;
+        }
+    }
+    let subtrees: Vec<Vec<usize>> = (0..n)
+        .map(|j| {
+            skeleton
+                .subtree(j)
+                .into_iter()
+                .filter(|&k| rotates[k])
+                .collect()
+        })
+        .collect();
+    // Candidate boundaries per joint (frame, subtree jump), in time order.
+    let mut candidates: Vec<Vec<(usize, f32)>> = vec![Vec::new(); n];
+    let mut values = Vec::new();
+    let mut jumps = vec![false; n];
+    let mut scores = vec![0.0f32; n];
+    let mut ancestor_jumps = vec![false; n];
+    for t in first..=last {
+        for j in 0..n {
+            // A root is never a spike (its subtree is the whole body, and
+            // the root carries the translation).
+            if skeleton.joint(j).parent.is_none()
+                || subtrees[j].len() < 2
+                || jump[t * n + j] <= options.threshold
+            {
+                jumps[j] = false;
+                continue;
+            }
+            values.clear();
+            values.extend(subtrees[j].iter().map(|&k| jump[t * n + k]));
+            values.sort_by(f32::total_cmp);
+            scores[j] = values[values.len() / 2];
+            jumps[j] = scores[j] > options.threshold;
+        }
+        // Only the topmost jumping joint of a branch is the spike's (joints
+        // without rotation channels in between do not count).
+        for j in 0..n {
+            ancestor_jumps[j] = skeleton
+                .joint(j)
+                .parent
+                .is_some_and(|p| jumps[p] || ancestor_jumps[p]);
+            if jumps[j] && !ancestor_jumps[j] {
+                candidates[j].push((t, scores[j]));
+            }
+        }
+    }
+    // A step seen through averaged windows rises and falls over
+    // `2 span - 1` frames: keep its peak.
+    let mut boundaries: Vec<Vec<usize>> = candidates
+        .iter()
+        .map(|list| {
+            list.iter()
+                .enumerate()
+                .filter(|&(i, &(t, score))| {
+                    list.iter().enumerate().all(|(i2, &(t2, score2))| {
+                        i2 == i
+                            || t.abs_diff(t2) >= span
+                            || score2 < score
+                            || (score2 == score && i < i2)
+                    })
+                })
+                .map(|(_, &(t, _))| t)
+                .collect()
+        })
+        .collect();
+    // Near a joint's boundary, a joint below it may peak a frame earlier or
+    // later: that is the same spike (parents come before children).
+    for j in 0..n {
+        let mut above = skeleton.joint(j).parent;
+        while let Some(a) = above {
+            let ancestor = boundaries[a].clone();
+            boundaries[j].retain(|&t| ancestor.iter().all(|&ta| t.abs_diff(ta) >= span));
+            above = skeleton.joint(a).parent;
+        }
+    }
+    let mut spikes = Vec::new();
+    for (joint, times) in boundaries.iter().enumerate() {
+        let mut i = 0;
+        while i + 1 < times.len() {
+            let (start, end) = (times[i], times[i + 1]);
+            if end - start <= options.max_frames {
+                spikes.push(FoundSpike {
+                    joint,
+                    start,
+                    frames: end - start,
+                });
+                i += 2;
+            } else {
+                i += 1;
+            }
+        }
+    }
+    spikes
+}
+
+/// `motion` with every found spike bridged by slerp (see the module docs),
+/// and the spikes.
+pub fn remove_spikes(motion: &Motion, options: &DespikeOptions) -> (Motion, Vec<FoundSpike>) {
+    let spikes = find_spikes(motion, options);
+    let mut out = motion.clone();
+    let skeleton = motion.skeleton();
+    for s in &spikes {
+        // Boundaries are found between frames 1 and frames - 1, so both
+        // frames of the bridge exist.
+        let (before, after) = (s.start - 1, s.start + s.frames);
+        for k in skeleton.subtree(s.joint) {
+            if !skeleton.joint(k).has_rotation_channels() {
+                continue;
+            }
+            let (a, b) = (out.local_rotation(before, k), out.local_rotation(after, k));
+            for f in s.start..after {
+                let w = (f - before) as f32 / (after - before) as f32;
+                out.set_local_rotation(f, k, slerp(a, b, w));
+            }
+        }
+    }
+    (out, spikes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::noise::{add_spikes, Spike, SpikeNoise};
+    use crate::test_support::{branching_motion, synthetic_motion_phase};
+    use rand::SeedableRng;
+
+    /// The branching test body with spikes from a shifted copy.
+    fn spiked(spikes: &mut [Spike]) -> (Motion, Motion, Vec<Spike>) {
+        let clean = branching_motion(200);
+        let mut donor = branching_motion(200);
+        let shifted = synthetic_motion_phase(200, 2, 1.5);
+        // The donor: the same body moving differently (every rotation
+        // turned by a slowly varying amount).
+        for f in 0..200 {
+            for j in [1, 2, 3, 5, 6] {
+                let extra = shifted.local_rotation(f, 1);
+                let q = donor.local_rotation(f, j) * extra * extra;
+                donor.set_local_rotation(f, j, q);
+            }
+        }
+        let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(2);
+        let (noisy, spikes) =
+            add_spikes(&clean, &[&donor], &SpikeNoise::default(), spikes, &mut rng).unwrap();
+        (clean, noisy, spikes)
+    }
+
+    #[test]
+    fn a_spike_is_found_at_its_joint_and_bridged() {
+        let (clean, noisy, spikes) = spiked(&mut [Spike {
+            joint: 0,
+            start: 60,
+            frames: 40,
+        }]);
+        let options = DespikeOptions::default();
+        let (repaired, found) = remove_spikes(&noisy, &options);
+        assert_eq!(
+            found,
+            vec![FoundSpike {
+                joint: spikes[0].joint,
+                start: 60,
+                frames: 40
+            }]
+        );
+        let error = |m: &Motion| -> f32 {
+            (60..100)
+                .flat_map(|f| {
+                    clean
+                        .skeleton()
+                        .subtree(spikes[0].joint)
+                        .into_iter()
+                        .map(move |k| (f, k))
+                })
+                .filter(|&(_, k)| clean.skeleton().joint(k).has_rotation_channels())
+                .map(|(f, k)| angle_between(clean.local_rotation(f, k), m.local_rotation(f, k)))
+                .sum()
+        };
+        assert!(
+            error(&repaired) < 0.5 * error(&noisy),
+            "{} vs {}",
+            error(&repaired),
+            error(&noisy)
+        );
+        // Nothing outside the spike changed.
+        for f in (0..60).chain(100..200) {
+            assert_eq!(repaired.frame(f), noisy.frame(f));
+        }
+    }
+
+    #[test]
+    fn smooth_motion_has_no_spikes() {
+        let clean = branching_motion(300);
+        assert!(find_spikes(&clean, &DespikeOptions::default()).is_empty());
+    }
+}
