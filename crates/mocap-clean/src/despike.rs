@@ -192,8 +192,9 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
     for j in 0..n {
         let mut above = skeleton.joint(j).parent;
         while let Some(a) = above {
-            let ancestor = boundaries[a].clone();
-            boundaries[j].retain(|&t| ancestor.iter().all(|&ta| t.abs_diff(ta) >= span));
+            let (before, from_j) = boundaries.split_at_mut(j);
+            let ancestor = &before[a];
+            from_j[0].retain(|&t| ancestor.iter().all(|&ta| t.abs_diff(ta) >= span));
             above = skeleton.joint(a).parent;
         }
     }

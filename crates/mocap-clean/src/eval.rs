@@ -244,14 +244,21 @@ const DESPIKE_THRESHOLDS: [f32; 7] = [2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
 const DESPIKE_SPANS: [usize; 3] = [1, 2, 3];
 
 /// The spike-finding settings that give the lowest mean rotation error
-/// when run on `cleaner`'s output of the tuning takes (spike condition).
+/// when run on `cleaner`'s output of the tuning takes (spike condition;
+/// `None`: on the noisy takes themselves).
 fn tune_despike(
     takes: &[Take],
-    cleaner: &Cleaner,
+    cleaner: Option<&Cleaner>,
     options: &EvalOptions,
 ) -> Result<(DespikeOptions, f64)> {
     let cleaned: Vec<Motion> = (0..takes.len())
-        .map(|i| cleaner.run(&make_noisy(takes, i, 1, options)?))
+        .map(|i| {
+            let noisy = make_noisy(takes, i, 1, options)?;
+            match cleaner {
+                Some(c) => c.run(&noisy),
+                None => Ok(noisy),
+            }
+        })
         .collect::<Result<_>>()?;
     let mut best: Option<(f64, DespikeOptions)> = None;
     let grid = DESPIKE_SPANS
@@ -280,8 +287,6 @@ fn tune_despike(
 enum Cleaner {
     Filter(Filter),
     Model(Box<CleanModel>),
-    /// The input unchanged (for `despike` alone).
-    Nothing,
 }
 
 impl Cleaner {
@@ -289,62 +294,73 @@ impl Cleaner {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
             Cleaner::Model(m) => m.clean(noisy, None),
-            Cleaner::Nothing => Ok(noisy.clone()),
         }
     }
 }
 
-/// A method of the evaluation: a cleaner, followed by spike finding or not.
-struct Method<'a> {
+/// A method of the evaluation: a cleaner's output (`None`: the noisy input
+/// itself), followed by spike finding or not.
+struct Method {
     label: String,
-    cleaner: &'a Cleaner,
+    cleaner: Option<usize>,
     despike: Option<DespikeOptions>,
 }
 
-impl Method<'_> {
-    fn run(&self, noisy: &Motion) -> Result<Motion> {
-        let cleaned = self.cleaner.run(noisy)?;
-        Ok(match &self.despike {
-            Some(d) => remove_spikes(&cleaned, d).0,
-            None => cleaned,
-        })
+/// Runs the methods on one noisy take and hands each output to `take`:
+/// every cleaner runs once, the spike-finding rows reuse its output.
+fn run_methods(
+    cleaners: &[&(String, Cleaner)],
+    methods: &[Method],
+    noisy: &Motion,
+    mut take: impl FnMut(usize, &Motion),
+) -> Result<()> {
+    let outputs: Vec<Motion> = cleaners
+        .iter()
+        .map(|(_, c)| c.run(noisy))
+        .collect::<Result<_>>()?;
+    for (k, method) in methods.iter().enumerate() {
+        let cleaned = method.cleaner.map_or(noisy, |i| &outputs[i]);
+        match &method.despike {
+            Some(d) => take(k, &remove_spikes(cleaned, d).0),
+            None => take(k, cleaned),
+        }
     }
+    Ok(())
 }
-
-/// The input unchanged, the cleaner of the `despike` row.
-static NOTHING: Cleaner = Cleaner::Nothing;
 
 /// The methods: `cleaners` as they are, then (when spike finding is asked)
 /// spike finding alone and every cleaner followed by it, with thresholds
 /// tuned per method on `tune_takes` (remembered by label in `tuned`).
-fn methods<'a>(
-    cleaners: &[&'a (String, Cleaner)],
+fn methods(
+    cleaners: &[&(String, Cleaner)],
     options: &EvalOptions,
     tune_takes: &[Take],
     tuned: &mut Vec<(String, DespikeOptions, f64)>,
-) -> Result<Vec<Method<'a>>> {
-    let mut out: Vec<Method<'a>> = cleaners
+) -> Result<Vec<Method>> {
+    let mut out: Vec<Method> = cleaners
         .iter()
-        .map(|(label, cleaner)| Method {
+        .enumerate()
+        .map(|(i, (label, _))| Method {
             label: label.clone(),
-            cleaner,
+            cleaner: Some(i),
             despike: None,
         })
         .collect();
     if !options.despike {
         return Ok(out);
     }
-    let alone = ("despike".to_string(), &NOTHING);
-    let with_despike = std::iter::once(alone).chain(
+    let with_despike = std::iter::once(("despike".to_string(), None)).chain(
         cleaners
             .iter()
-            .map(|(label, cleaner)| (format!("{label} + despike"), cleaner)),
+            .enumerate()
+            .map(|(i, (label, _))| (format!("{label} + despike"), Some(i))),
     );
     for (label, cleaner) in with_despike {
         let despike = match tuned.iter().find(|(l, _, _)| *l == label) {
             Some((_, d, _)) => *d,
             None => {
-                let (d, error) = tune_despike(tune_takes, cleaner, options)?;
+                let (d, error) =
+                    tune_despike(tune_takes, cleaner.map(|i| &cleaners[i].1), options)?;
                 tuned.push((label.clone(), d, error));
                 d
             }
@@ -434,9 +450,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 sums[slot][2] += a * w;
             };
             add(0, &noisy);
-            for (k, method) in methods.iter().enumerate() {
-                add(k + 1, &method.run(&noisy)?);
-            }
+            run_methods(&cleaners, &methods, &noisy, |k, m| add(k + 1, m))?;
             bar.inc(1);
         }
         bar.finish_and_clear();
@@ -497,9 +511,9 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 e / (s.frames * joints.len()) as f64
             };
             noisy_sum += region(&noisy);
-            for (k, method) in spike_methods.iter().enumerate() {
-                residual[k] += region(&method.run(&noisy)?);
-            }
+            run_methods(&cleaners, &spike_methods, &noisy, |k, m| {
+                residual[k] += region(m)
+            })?;
             count += 1;
         }
         if count == 0 {
