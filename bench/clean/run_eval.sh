@@ -3,7 +3,8 @@
 # classical filters (tuned on 12 validation takes per condition), the shipped model (trained by
 # bench/clean/base_filter.sh --window32), the same with 16-frame windows (bench/clean/base_filter.sh), the report's model without a base filter (bench/clean/plain_model.sh), the
 # model shipped before this session (trained on the earlier noise, for reference), each also followed by
-# spike finding (tuned per method), on every test take of ../shared/data/bandai; then the speed benchmark.
+# spike finding (tuned per method), on every test take of ../shared/data/bandai, under three noise conditions
+# (random; spikes on random noise; spikes alone); then the speed benchmark.
 # Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
 cd "$(dirname "$0")/../.."

@@ -1,4 +1,4 @@
-//! Finding and bridging spikes: a classical stage run before a denoiser.
+//! Finding and bridging spikes by hand-written rules: a classical stage, run alone or after a denoiser.
 //!
 //! A spike of markerless capture (a wrong association with another person,
 //! [`crate::noise::SpikeNoise`]) gives a joint and every joint below it the

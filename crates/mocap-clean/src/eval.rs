@@ -13,6 +13,11 @@
 //! search for the lowest rotation error) and then run on the evaluation
 //! takes with those settings.
 //!
+//! With [`EvalOptions::spike_detector`], the learned spike detector
+//! ([`crate::spikes`]) runs alone and before the first filter and every
+//! model (rows `DETECTOR` and `DETECTOR + METHOD`): it looks for spikes in
+//! the noisy input, before anything smooths their ends.
+//!
 //! With [`EvalOptions::despike`], every method is also followed by spike
 //! finding ([`crate::despike`]; rows `METHOD + despike`, and `despike` alone
 //! on the noisy input), its threshold tuned per method the same way (on the
@@ -20,6 +25,7 @@
 //! removes the random noise that hides a spike's ends and leaves the spike.
 
 use std::path::PathBuf;
+use std::rc::Rc;
 
 use mocap_core::rotation::angle_between;
 use mocap_core::{forward_kinematics, metrics, Motion};
@@ -33,6 +39,7 @@ use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::CleanModel;
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
+use crate::spikes::{SpikeDetector, SpikeOptions};
 use crate::{CleanError, Result};
 
 /// Mean geodesic angle (degrees) between the local rotations of two
@@ -93,6 +100,11 @@ pub struct EvalOptions {
     /// takes (see the module docs).
     #[serde(default)]
     pub despike: bool,
+    /// Also run this learned spike detector alone and before the first
+    /// filter and every model (see the module docs; `path` is required:
+    /// no detector ships).
+    #[serde(default)]
+    pub spike_detector: Option<ModelEntry>,
     pub seed: u64,
     pub device: DeviceChoice,
 }
@@ -114,6 +126,7 @@ impl Default for EvalOptions {
             spikes: SpikeNoise::default(),
             spike_lengths: vec![2, 4, 8, 16, 32, 64],
             despike: false,
+            spike_detector: None,
             seed: 7,
             device: DeviceChoice::Cpu,
         }
@@ -156,8 +169,13 @@ pub struct EvalReport {
     pub spike_survival: Vec<SpikeSurvival>,
 }
 
-/// The noise conditions evaluated.
-pub const CONDITIONS: [&str; 2] = ["random", "spikes"];
+/// The noise conditions evaluated: random noise alone, spikes on top of
+/// random noise, and spikes alone (the "spike noise" on its own:
+/// what a method does to a spike without random noise hiding its ends).
+pub const CONDITIONS: [&str; 3] = ["random", "spikes", "spikes only"];
+
+/// Index of the spikes-only condition in [`CONDITIONS`].
+const SPIKES_ONLY: usize = 2;
 
 /// A deterministic generator for (take, condition).
 fn rng_for(seed: u64, take: usize, condition: usize) -> ChaCha8Rng {
@@ -166,12 +184,17 @@ fn rng_for(seed: u64, take: usize, condition: usize) -> ChaCha8Rng {
     )
 }
 
-/// The noisy copy of take `i` under `condition`: random noise alone, or
-/// spikes (from other takes) on top of random noise.
+/// The noisy copy of take `i` under `condition` (see [`CONDITIONS`]):
+/// random noise alone, spikes (from other takes) on top of random noise, or
+/// spikes alone.
 fn make_noisy(takes: &[Take], i: usize, condition: usize, options: &EvalOptions) -> Result<Motion> {
     let mut rng = rng_for(options.seed, i, condition);
     let clean = &takes[i].motion;
-    let (noisy, _) = add_random_noise(clean, &options.random, &mut rng);
+    let noisy = if condition == SPIKES_ONLY {
+        clean.clone()
+    } else {
+        add_random_noise(clean, &options.random, &mut rng).0
+    };
     if condition == 0 {
         return Ok(noisy);
     }
@@ -284,9 +307,13 @@ fn tune_despike(
     Ok((despike, error))
 }
 
+#[derive(Clone)]
 enum Cleaner {
     Filter(Filter),
-    Model(Box<CleanModel>),
+    Model(Rc<CleanModel>),
+    Spikes(Rc<SpikeDetector>),
+    /// The first, then the second on its output.
+    Then(Box<Cleaner>, Box<Cleaner>),
 }
 
 impl Cleaner {
@@ -294,8 +321,31 @@ impl Cleaner {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
             Cleaner::Model(m) => m.clean(noisy, None),
+            Cleaner::Spikes(d) => Ok(d.remove_spikes(noisy, &SpikeOptions::default())?.0),
+            Cleaner::Then(first, second) => second.run(&first.run(noisy)?),
         }
     }
+}
+
+/// The spike detector's rows: alone, then before the first filter (the
+/// best family, Butterworth) and before every model.
+fn detector_rows(
+    detector: Option<&(String, Rc<SpikeDetector>)>,
+    filters: &[(String, Cleaner)],
+    models: &[(String, Cleaner)],
+) -> Vec<(String, Cleaner)> {
+    let Some((label, d)) = detector else {
+        return Vec::new();
+    };
+    let spikes = Cleaner::Spikes(d.clone());
+    let mut rows = vec![(label.clone(), spikes.clone())];
+    for (name, c) in filters.iter().take(1).chain(models) {
+        rows.push((
+            format!("{label} + {name}"),
+            Cleaner::Then(Box::new(spikes.clone()), Box::new(c.clone())),
+        ));
+    }
+    rows
 }
 
 /// A method of the evaluation: a cleaner's output (`None`: the noisy input
@@ -400,8 +450,22 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             Some(p) => CleanModel::load(p, options.device)?,
             None => CleanModel::load_default(options.device)?,
         };
-        models.push((m.label.clone(), Cleaner::Model(Box::new(model))));
+        models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
     }
+    let detector = match &options.spike_detector {
+        Some(entry) => Some((
+            entry.label.clone(),
+            Rc::new(match &entry.path {
+                Some(p) => SpikeDetector::load(p, options.device)?,
+                None => {
+                    return Err(CleanError::Invalid(
+                        "the spike detector needs a model file (none ships)".into(),
+                    ))
+                }
+            }),
+        )),
+        None => None,
+    };
     let mut tuned_filters = Vec::new();
     let mut per_condition: Vec<Vec<(String, Cleaner)>> = Vec::new();
     let tune_takes = if options.filters || options.despike {
@@ -429,7 +493,12 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
 
     let mut entries = Vec::new();
     for (condition, filters) in per_condition.iter().enumerate() {
-        let cleaners: Vec<_> = filters.iter().chain(models.iter()).collect();
+        let detected = detector_rows(detector.as_ref(), filters, &models);
+        let cleaners: Vec<_> = filters
+            .iter()
+            .chain(models.iter())
+            .chain(detected.iter())
+            .collect();
         let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
         let mut frames_total = 0usize;
@@ -468,13 +537,15 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     }
 
     // Spike survival: one spike of each length in the middle of each take
-    // (no random noise), error measured on the spiked joints and frames.
+    // (no random noise), error measured on the spiked joints and frames;
+    // the filters are those tuned for spikes alone.
     let mut spike_survival = Vec::new();
-    let cleaners: Vec<_> = per_condition
-        .get(1)
-        .into_iter()
-        .flatten()
+    let spike_filters = per_condition.get(SPIKES_ONLY).map_or(&[][..], |f| &f[..]);
+    let detected = detector_rows(detector.as_ref(), spike_filters, &models);
+    let cleaners: Vec<_> = spike_filters
+        .iter()
         .chain(models.iter())
+        .chain(detected.iter())
         .collect();
     let spike_methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
     for &length in &options.spike_lengths {

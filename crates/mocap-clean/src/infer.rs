@@ -26,7 +26,8 @@ use serde::{Deserialize, Serialize};
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::FeatureLayout;
 use crate::filters::{filter_features, filter_motion, Filter};
-use crate::model::Denoiser;
+use crate::model::{Denoiser, Head};
+use crate::spikes::{SpikeDetector, SpikeOptions};
 use crate::training::{ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
 use crate::{CleanError, Result};
 
@@ -110,8 +111,15 @@ impl CleanModel {
         })
     }
 
-    /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
-    pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
+    /// The network and the device it runs on (the spike detector of
+    /// [`crate::spikes`] runs it on its own).
+    pub(crate) fn network(&self) -> (&Denoiser, &Device) {
+        (&self.model, &self.device)
+    }
+
+    /// The features of `motion`'s rig, or an error when the model was
+    /// trained on another rig.
+    pub(crate) fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
         let layout = FeatureLayout::new(motion.skeleton(), self.description.representation)?
             .in_frame(self.description.frame)?;
         let c = layout.channels();
@@ -126,6 +134,20 @@ impl CleanModel {
                 self.description.network.channels,
             )));
         }
+        Ok(layout)
+    }
+
+    /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
+    pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
+        if self.description.network.head != Head::Correction {
+            return Err(CleanError::Invalid(format!(
+                "{} is a spike detector (`mocap clean train --spike-detector`), not a denoiser: \
+                 give it with --spike-model",
+                self.source.display()
+            )));
+        }
+        let layout = self.layout_for(motion)?;
+        let c = layout.channels();
         let t = self.description.network.window;
         let hop = hop.unwrap_or(t / 4).clamp(1, t);
         let frames = motion.frame_count();
@@ -252,6 +274,19 @@ pub struct CleanOptions {
     /// Look for spikes after cleaning and bridge them ([`crate::despike`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
+    /// Find spikes with the learned detector *before* cleaning and bridge
+    /// them ([`crate::spikes`]).
+    #[serde(default)]
+    pub find_spikes: Option<FindSpikes>,
+}
+
+/// Learned spike finding before cleaning.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FindSpikes {
+    /// A detector written by `mocap clean train --spike-detector` (none
+    /// ships: see [`crate::spikes`] for what one trained here does).
+    pub model: PathBuf,
+    pub options: SpikeOptions,
 }
 
 /// What `mocap clean IN -o OUT` reports.
@@ -269,11 +304,30 @@ pub struct CleanReport {
     /// The spikes found and bridged (with `despike`).
     #[serde(default)]
     pub spikes: Vec<FoundSpike>,
+    /// The spikes the learned detector found and bridged before cleaning
+    /// (with `find_spikes`): the top joint of each marked subtree.
+    #[serde(default)]
+    pub detected_spikes: Vec<FoundSpike>,
 }
 
 /// Reads a take, cleans it and writes it (atomically).
 pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
-    let motion = read_bvh(&options.input)?;
+    let original = read_bvh(&options.input)?;
+    let in_file = |e: CleanError| match e {
+        CleanError::Invalid(m) => CleanError::Invalid(format!("{}: {m}", options.input.display())),
+        other => other,
+    };
+    let start = Instant::now();
+    let (motion, detected_spikes) = match &options.find_spikes {
+        Some(find) => {
+            let detector = SpikeDetector::load(&find.model, options.device)?;
+            detector
+                .remove_spikes(&original, &find.options)
+                .map_err(in_file)?
+        }
+        None => (original.clone(), Vec::new()),
+    };
+    let detect_seconds = start.elapsed().as_secs_f64();
     let (cleaned, method, seconds) = match &options.method {
         Method::Filter(filter) => {
             let start = Instant::now();
@@ -286,12 +340,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                 _ => CleanModel::load_default(options.device)?,
             };
             let start = Instant::now();
-            let out = model.clean(&motion, options.hop).map_err(|e| match e {
-                CleanError::Invalid(m) => {
-                    CleanError::Invalid(format!("{}: {m}", options.input.display()))
-                }
-                other => other,
-            })?;
+            let out = model.clean(&motion, options.hop).map_err(in_file)?;
             (
                 out,
                 format!("model {}", model.source.display()),
@@ -305,6 +354,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
     };
     write_bvh(&options.output, &cleaned)?;
     let frames = motion.frame_count();
+    let seconds = seconds + detect_seconds;
     Ok(CleanReport {
         input: options.input.clone(),
         output: options.output.clone(),
@@ -312,8 +362,9 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         frames,
         seconds,
         frames_per_second: frames as f64 / seconds.max(1e-9),
-        mean_change_deg: crate::eval::rotation_error_deg(&motion, &cleaned),
+        mean_change_deg: crate::eval::rotation_error_deg(&original, &cleaned),
         spikes,
+        detected_spikes,
     })
 }
 

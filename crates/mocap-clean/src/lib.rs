@@ -14,7 +14,10 @@
 //! - [`noise`]: the two noise models (chain-corrected random noise, spikes);
 //! - [`features`]: rotation representations fed to the network;
 //! - [`despike`]: finding spikes by the jumps at their ends and bridging
-//!   them, a classical stage before a denoiser;
+//!   them, a classical stage after a denoiser;
+//! - [`spikes`]: a learned spike detector (the network with one output per
+//!   joint and frame) and bridging of what it marks, a stage before a
+//!   denoiser;
 //! - [`filters`]: classical baselines (zero-phase Butterworth,
 //!   Savitzky-Golay, median, One Euro);
 //! - [`dataset`]: BVH takes split by take, windows;
@@ -39,6 +42,7 @@ pub mod infer;
 pub mod loss;
 pub mod model;
 pub mod noise;
+pub mod spikes;
 pub mod training;
 
 #[cfg(test)]

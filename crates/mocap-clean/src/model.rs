@@ -15,6 +15,11 @@
 //! Residual blocks are `relu(x + conv(relu(conv(x))))`. The global skip makes
 //! the network predict a correction to its input, which is small for random
 //! noise. Every skip connection adds tensors of the same size.
+//!
+//! The same network with another head ([`Head::SpikeLogits`]: one output per
+//! joint, no global skip) is the learned spike detector of
+//! [`crate::spikes`]: for every joint and frame, the logit of "this joint's
+//! rotation belongs to another motion here".
 
 use burn::module::Module;
 use burn::nn::conv::{Conv1d, Conv1dConfig, ConvTranspose1d, ConvTranspose1dConfig};
@@ -41,6 +46,20 @@ pub struct DenoiserConfig {
     pub kernel: usize,
     /// Frames per window (report: 16); a multiple of `2^levels`.
     pub window: usize,
+    /// What the network outputs (default: a denoised copy of its input).
+    #[serde(default)]
+    pub head: Head,
+}
+
+/// What the network outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Head {
+    /// The input plus a learned correction (the denoiser).
+    #[default]
+    Correction,
+    /// One logit per joint and frame, without the global skip (the spike
+    /// detector of [`crate::spikes`]).
+    SpikeLogits { joints: usize },
 }
 
 impl DenoiserConfig {
@@ -53,6 +72,7 @@ impl DenoiserConfig {
             blocks: 1,
             kernel: 3,
             window: 16,
+            head: Head::Correction,
         }
     }
 
@@ -65,6 +85,7 @@ impl DenoiserConfig {
             blocks: 4,
             kernel: 3,
             window: 16,
+            head: Head::Correction,
         }
     }
 
@@ -77,6 +98,9 @@ impl DenoiserConfig {
         if self.kernel.is_multiple_of(2) {
             return bad("the kernel size must be odd");
         }
+        if self.head == (Head::SpikeLogits { joints: 0 }) {
+            return bad("a spike detector needs at least one joint");
+        }
         if self.levels > 6 || self.window == 0 || !self.window.is_multiple_of(1 << self.levels) {
             return bad("the window must be a positive multiple of 2^levels (levels at most 6)");
         }
@@ -85,6 +109,14 @@ impl DenoiserConfig {
 
     fn width_at(&self, level: usize) -> usize {
         self.width << level
+    }
+
+    /// Channels of the output: the input's, or one per joint.
+    pub fn output_channels(&self) -> usize {
+        match self.head {
+            Head::Correction => self.channels,
+            Head::SpikeLogits { joints } => joints,
+        }
     }
 
     /// Builds the network with fresh weights on `device`.
@@ -127,7 +159,8 @@ impl DenoiserConfig {
             encoder,
             bottleneck: blocks(self.width_at(self.levels)),
             decoder,
-            output: conv(self.width, self.channels),
+            output: conv(self.width, self.output_channels()),
+            residual: self.head == Head::Correction,
         })
     }
 
@@ -136,7 +169,8 @@ impl DenoiserConfig {
         let k = self.kernel;
         let conv = |cin: usize, cout: usize, k: usize| cin * cout * k + cout;
         let block = |w: usize| 2 * conv(w, w, k);
-        let mut n = conv(self.channels, self.width, k) + conv(self.width, self.channels, k);
+        let mut n =
+            conv(self.channels, self.width, k) + conv(self.width, self.output_channels(), k);
         for level in 0..self.levels {
             let (w, w2) = (self.width_at(level), self.width_at(level + 1));
             n += 2 * self.blocks * block(w) + conv(w, w2, 4) + (w2 * w * 4 + w);
@@ -179,11 +213,16 @@ pub struct Denoiser {
     bottleneck: Vec<ResBlock>,
     decoder: Vec<DecoderLevel>,
     output: Conv1d,
+    /// Whether the input is added to the output (the global skip; not for
+    /// a spike detector). Not a weight: it comes from the configuration.
+    #[module(skip)]
+    residual: bool,
 }
 
 impl Denoiser {
-    /// Cleans a batch `[batch, channels, frames]`; `frames` must be a
-    /// multiple of `2^levels`.
+    /// Runs a batch `[batch, channels, frames]` (`frames` a multiple of
+    /// `2^levels`): the cleaned batch, or `[batch, joints, frames]` logits
+    /// for a spike detector.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let mut h = relu(self.input.forward(x.clone()));
         let mut skips = Vec::with_capacity(self.encoder.len());
@@ -204,7 +243,12 @@ impl Denoiser {
                 h = b.forward(h);
             }
         }
-        x + self.output.forward(h)
+        let out = self.output.forward(h);
+        if self.residual {
+            x + out
+        } else {
+            out
+        }
     }
 }
 
@@ -220,6 +264,74 @@ mod tests {
         let x = Tensor::<3>::zeros([2, 12, 16], &device);
         assert_eq!(model.forward(x).dims(), [2, 12, 16]);
         assert_eq!(model.num_params(), config.parameter_count());
+    }
+
+    #[test]
+    fn a_spike_detector_has_one_output_per_joint() {
+        let device = Device::flex();
+        let config = DenoiserConfig {
+            head: Head::SpikeLogits { joints: 2 },
+            ..DenoiserConfig::small(12)
+        };
+        let model = config.init(&device).unwrap();
+        let x = Tensor::<3>::zeros([3, 12, 16], &device);
+        assert_eq!(model.forward(x).dims(), [3, 2, 16]);
+        assert_eq!(model.num_params(), config.parameter_count());
+    }
+
+    /// Conv1d weight gradients of burn's CPU backend against finite
+    /// differences (batch > 1, several channels, `Same` padding).
+    #[test]
+    fn conv_weight_gradients_match_finite_differences() {
+        use burn::module::Param;
+        let device = Device::flex().autodiff();
+        let (b, cin, cout, t, k) = (3, 4, 5, 9, 3);
+        let data = |n: usize, seed: f32| -> Vec<f32> {
+            (0..n)
+                .map(|i| (i as f32 * 0.7 + seed).sin() * 1.3)
+                .collect()
+        };
+        let x = Tensor::<1>::from_floats(data(b * cin * t, 0.1).as_slice(), &device)
+            .reshape([b, cin, t]);
+        let target = Tensor::<1>::from_floats(data(b * cout * t, 2.0).as_slice(), &device)
+            .reshape([b, cout, t]);
+        let w0 = data(cout * cin * k, 5.0);
+        let loss_of = |w: &[f32], grad: bool| {
+            let mut conv = Conv1dConfig::new(cin, cout, k)
+                .with_padding(PaddingConfig1d::Same)
+                .with_bias(false)
+                .init(&device);
+            let wt = Tensor::<1>::from_floats(w, &device).reshape([cout, cin, k]);
+            conv.weight = Param::from_tensor(if grad { wt.require_grad() } else { wt });
+            let y = conv.forward(x.clone());
+            let loss = (y - target.clone()).powi_scalar(2).mean();
+            (conv, loss)
+        };
+        let (conv, loss) = loss_of(&w0, true);
+        let grads = loss.backward();
+        let g: Vec<f32> = conv
+            .weight
+            .val()
+            .grad(&grads)
+            .unwrap()
+            .into_data()
+            .try_to_vec()
+            .unwrap();
+        for i in [0, 7, 13, 31, 59] {
+            let h = 1e-2;
+            let mut wp = w0.clone();
+            wp[i] += h;
+            let mut wm = w0.clone();
+            wm[i] -= h;
+            let lp: f32 = loss_of(&wp, false).1.into_scalar();
+            let lm: f32 = loss_of(&wm, false).1.into_scalar();
+            let numeric = (lp - lm) / (2.0 * h);
+            assert!(
+                (g[i] - numeric).abs() < 1e-3 * (1.0 + numeric.abs()),
+                "weight {i}: autodiff {} numeric {numeric}",
+                g[i]
+            );
+        }
     }
 
     #[test]

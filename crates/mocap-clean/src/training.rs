@@ -9,6 +9,11 @@
 //! so runs with different seeds and losses are validated on the same data.
 //! The validation loss is the plain mean squared error of the features, for
 //! every training loss, so that curves of different losses compare.
+//!
+//! With [`TrainOptions::spike_detector`] the same loop trains the learned
+//! spike detector of [`crate::spikes`] instead: the network's head gives one
+//! logit per joint and frame, the target is the mask of the spikes the noise
+//! added, and the loss (training and validation) is the binary cross-entropy.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -32,9 +37,10 @@ use crate::dataset::{
 use crate::features::{FeatureLayout, Representation, RotationFrame};
 use crate::filters::{filter_features, Filter};
 use crate::fk::FkSkeleton;
-use crate::loss::{derivative_loss, position_loss, LossWeights};
-use crate::model::{Denoiser, DenoiserConfig};
-use crate::noise::{add_noise, NoiseConfig};
+use crate::loss::{binary_cross_entropy_with_logits, derivative_loss, position_loss, LossWeights};
+use crate::model::{Denoiser, DenoiserConfig, Head};
+use crate::noise::{add_noise_with_spikes, NoiseConfig, Spike};
+use crate::spikes::spike_mask;
 use crate::{CleanError, Result};
 
 /// The kind written in checkpoint headers.
@@ -112,6 +118,10 @@ pub struct TrainOptions {
     /// squared skeleton unit; 0 leaves it out (the report's loss).
     #[serde(default)]
     pub position_weight: f32,
+    /// Train the spike detector of [`crate::spikes`] instead of a denoiser
+    /// (see the module docs).
+    #[serde(default)]
+    pub spike_detector: bool,
 }
 
 impl Default for TrainOptions {
@@ -142,6 +152,7 @@ impl Default for TrainOptions {
             plot: None,
             max_train_takes: None,
             position_weight: 0.0,
+            spike_detector: false,
         }
     }
 }
@@ -179,6 +190,9 @@ pub struct WindowSampler<'a> {
     /// The base filter of the model and the frame rate (see
     /// [`ModelDescription::base_filter`]).
     base: Option<(Filter, f32)>,
+    /// Targets are spike masks (one value per joint and frame) instead of
+    /// the clean features.
+    spike_targets: bool,
 }
 
 impl<'a> WindowSampler<'a> {
@@ -212,6 +226,7 @@ impl<'a> WindowSampler<'a> {
             frames,
             noise,
             base: None,
+            spike_targets: false,
         })
     }
 
@@ -220,6 +235,22 @@ impl<'a> WindowSampler<'a> {
     pub fn with_base_filter(mut self, base: Option<Filter>, fps: f32) -> Self {
         self.base = base.map(|f| (f, fps));
         self
+    }
+
+    /// Targets for a spike detector: the mask of the added spikes
+    /// ([`spike_mask`]), `[batch, joints, frames]`.
+    pub fn with_spike_targets(mut self, on: bool) -> Self {
+        self.spike_targets = on;
+        self
+    }
+
+    /// Rows of a target window: features, or joints for spike masks.
+    fn target_channels(&self) -> usize {
+        if self.spike_targets {
+            self.layout.joints.len()
+        } else {
+            self.layout.channels()
+        }
     }
 
     fn pick<R: Rng + ?Sized>(&self, rng: &mut R) -> (usize, usize) {
@@ -232,6 +263,15 @@ impl<'a> WindowSampler<'a> {
 
     /// One clean window and its noisy copy.
     pub fn sample_motion<R: Rng + ?Sized>(&self, rng: &mut R) -> Result<(Motion, Motion)> {
+        let (noisy, clean, _) = self.sample_with_spikes(rng)?;
+        Ok((noisy, clean))
+    }
+
+    /// One clean window, its noisy copy and the spikes added to it.
+    pub fn sample_with_spikes<R: Rng + ?Sized>(
+        &self,
+        rng: &mut R,
+    ) -> Result<(Motion, Motion, Vec<Spike>)> {
         let (t, start) = self.pick(rng);
         let clean = window(&self.takes[t].motion, start, self.frames);
         // Spike donors: windows of other takes.
@@ -244,25 +284,32 @@ impl<'a> WindowSampler<'a> {
             donors.push(window(&self.takes[d].motion, s, self.frames));
         }
         let donor_refs: Vec<&Motion> = donors.iter().collect();
-        let noisy = add_noise(&clean, &donor_refs, &self.noise, rng)?;
-        Ok((noisy, clean))
+        let (noisy, spikes) = add_noise_with_spikes(&clean, &donor_refs, &self.noise, rng)?;
+        Ok((noisy, clean, spikes))
     }
 
-    /// A batch as `[batch, channels, frames]` tensor data (noisy, clean).
+    /// A batch as `[batch, channels, frames]` tensor data (noisy, clean), or
+    /// (noisy, spike mask `[batch, joints, frames]`) with spike targets.
     ///
     /// Each sample has its own generator seeded from `rng`, so the batch is
     /// the same whatever the number of threads that make it.
     pub fn batch<R: Rng + ?Sized>(&self, rng: &mut R, size: usize) -> Result<(Vec<f32>, Vec<f32>)> {
         use rayon::prelude::*;
         let c = self.layout.channels();
+        let cy = self.target_channels();
         let t = self.frames;
         let seeds: Vec<u64> = (0..size).map(|_| rng.random::<u64>()).collect();
         let samples = seeds
             .par_iter()
             .map(|&seed| {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
-                let (noisy, clean) = self.sample_motion(&mut rng)?;
+                let (noisy, clean, spikes) = self.sample_with_spikes(&mut rng)?;
                 let mut xf = self.layout.encode(&noisy);
+                if self.spike_targets {
+                    self.layout.recenter(&mut xf);
+                    let mask = spike_mask(&clean, &noisy, &self.layout.joints, &spikes);
+                    return Ok((xf, mask));
+                }
                 let mut yf = self.layout.encode(&clean);
                 // Euler angles and exponential maps: the target on the
                 // input's branch, then both brought to the canonical range
@@ -282,12 +329,14 @@ impl<'a> WindowSampler<'a> {
             })
             .collect::<Result<Vec<_>>>()?;
         let mut x = vec![0.0; size * c * t];
-        let mut y = vec![0.0; size * c * t];
+        let mut y = vec![0.0; size * cy * t];
         for (b, (xf, yf)) in samples.iter().enumerate() {
             for f in 0..t {
                 for ch in 0..c {
                     x[(b * c + ch) * t + f] = xf[f * c + ch];
-                    y[(b * c + ch) * t + f] = yf[f * c + ch];
+                }
+                for ch in 0..cy {
+                    y[(b * cy + ch) * t + f] = yf[f * cy + ch];
                 }
             }
         }
@@ -299,22 +348,28 @@ fn tensor(data: Vec<f32>, shape: [usize; 3], device: &Device) -> Tensor<3> {
     Tensor::from_data(TensorData::new(data, shape), device)
 }
 
-/// The mean squared error of `model` on fixed validation batches.
-fn validation_mse(
+/// The mean squared error of `model` on fixed validation batches, or the
+/// binary cross-entropy for a spike detector (`target_shape` has one row per
+/// joint).
+fn validation_loss(
     model: &Denoiser,
     batches: &[(Vec<f32>, Vec<f32>)],
     shape: [usize; 3],
+    target_shape: [usize; 3],
+    spike_detector: bool,
     device: &Device,
 ) -> f64 {
     let model = model.valid();
     let mut sum = 0.0;
     for (x, y) in batches {
         let pred = model.forward(tensor(x.clone(), shape, device));
-        let mse: f32 = (pred - tensor(y.clone(), shape, device))
-            .powi_scalar(2)
-            .mean()
-            .into_scalar();
-        sum += mse as f64;
+        let target = tensor(y.clone(), target_shape, device);
+        let loss: f32 = if spike_detector {
+            binary_cross_entropy_with_logits(pred, target).into_scalar()
+        } else {
+            (pred - target).powi_scalar(2).mean().into_scalar()
+        };
+        sum += loss as f64;
     }
     sum / batches.len().max(1) as f64
 }
@@ -347,6 +402,16 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .collect();
     let mut network = options.network;
     network.channels = layout.channels();
+    if options.spike_detector {
+        if options.base_filter.is_some() || options.position_weight > 0.0 {
+            return Err(CleanError::Invalid(
+                "a spike detector has no base filter and no position term".into(),
+            ));
+        }
+        network.head = Head::SpikeLogits {
+            joints: layout.joints.len(),
+        };
+    }
     network.validate()?;
     let description = ModelDescription {
         network,
@@ -397,10 +462,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         None
     };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps);
+        .with_base_filter(options.base_filter, fps)
+        .with_spike_targets(options.spike_detector);
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps);
+        .with_base_filter(options.base_filter, fps)
+        .with_spike_targets(options.spike_detector);
     let shape = [options.batch_size, network.channels, network.window];
+    let target_shape = [
+        options.batch_size,
+        network.output_channels(),
+        network.window,
+    ];
     let mut valid_rng = ChaCha8Rng::seed_from_u64(VALIDATION_SEED);
     let valid_batches = (0..options
         .validation_windows
@@ -409,18 +481,28 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .map(|_| valid_sampler.batch(&mut valid_rng, options.batch_size))
         .collect::<Result<Vec<_>>>()?;
 
-    // The validation MSE of doing nothing (the noisy input itself), for scale.
-    let validation_input_mse = valid_batches
-        .iter()
-        .map(|(x, y)| {
-            x.iter()
-                .zip(y)
-                .map(|(a, b)| ((a - b) * (a - b)) as f64)
-                .sum::<f64>()
-                / x.len() as f64
-        })
-        .sum::<f64>()
-        / valid_batches.len() as f64;
+    // The validation MSE of doing nothing (the noisy input itself), for
+    // scale; for a spike detector, the cross-entropy of always answering the
+    // share of spiked joints and frames.
+    let validation_input_mse = if options.spike_detector {
+        let (ones, total) = valid_batches.iter().fold((0.0, 0usize), |(o, n), (_, y)| {
+            (o + y.iter().map(|&v| v as f64).sum::<f64>(), n + y.len())
+        });
+        let p = (ones / total.max(1) as f64).clamp(1e-9, 1.0 - 1e-9);
+        -(p * p.ln() + (1.0 - p) * (1.0 - p).ln())
+    } else {
+        valid_batches
+            .iter()
+            .map(|(x, y)| {
+                x.iter()
+                    .zip(y)
+                    .map(|(a, b)| ((a - b) * (a - b)) as f64)
+                    .sum::<f64>()
+                    / x.len() as f64
+            })
+            .sum::<f64>()
+            / valid_batches.len() as f64
+    };
     let device = options.device.training_device()?;
     let plain_device = options.device.device()?;
     seed_device(&device, options.seed);
@@ -495,8 +577,12 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             run.data_seconds += data_start.elapsed().as_secs_f64();
             let model = run.model.take().expect("model present");
             let pred = model.forward(tensor(x, shape, &device));
-            let target = tensor(y, shape, &device);
-            let mut l = derivative_loss(pred.clone(), target.clone(), &loss);
+            let target = tensor(y, target_shape, &device);
+            let mut l = if options.spike_detector {
+                binary_cross_entropy_with_logits(pred.clone(), target.clone())
+            } else {
+                derivative_loss(pred.clone(), target.clone(), &loss)
+            };
             if let Some(fk) = &fk {
                 l = l + position_loss(fk, pred, target) * options.position_weight;
             }
@@ -506,10 +592,12 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             Ok(value)
         },
         |run, _epoch| {
-            Ok(validation_mse(
+            Ok(validation_loss(
                 run.model.as_ref().expect("model"),
                 &valid_batches,
                 shape,
+                target_shape,
+                options.spike_detector,
                 &plain_device,
             ))
         },
@@ -524,16 +612,23 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 &model.valid(),
                 &header(history),
                 &plot,
-                &PlotOptions {
-                    y_label: "loss (training: chosen loss; validation: MSE)".into(),
-                    ..PlotOptions::new(format!(
-                        "mocap-clean training ({})",
-                        if loss.is_mse() {
-                            "MSE"
-                        } else {
-                            "derivative loss"
-                        }
-                    ))
+                &if options.spike_detector {
+                    PlotOptions {
+                        y_label: "binary cross-entropy".into(),
+                        ..PlotOptions::new("mocap-clean spike detector training")
+                    }
+                } else {
+                    PlotOptions {
+                        y_label: "loss (training: chosen loss; validation: MSE)".into(),
+                        ..PlotOptions::new(format!(
+                            "mocap-clean training ({})",
+                            if loss.is_mse() {
+                                "MSE"
+                            } else {
+                                "derivative loss"
+                            }
+                        ))
+                    }
                 },
             )?;
             Ok(())
@@ -587,6 +682,7 @@ mod tests {
                 blocks: 1,
                 kernel: 3,
                 window: 8,
+                head: Head::Correction,
             },
             epochs: 2,
             steps_per_epoch: 2,
@@ -701,5 +797,48 @@ mod tests {
         let cleaned = model.clean(&motion, None).unwrap();
         assert!(cleaned.values().iter().all(|v| v.is_finite()));
         assert_eq!(cleaned.frame_count(), 50);
+    }
+
+    #[test]
+    fn a_spike_detector_trains_and_is_told_apart_from_a_denoiser() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let options = TrainOptions {
+            out: dir.path().join("spikes.safetensors"),
+            spike_detector: true,
+            ..tiny_setup(dir.path())
+        };
+        let report = train(&options).unwrap();
+        // The base rate's cross-entropy is between 0 and ln 2 (share below
+        // one half), and so is every epoch's validation loss.
+        assert!(report.validation_input_mse > 0.0 && report.validation_input_mse < 0.7);
+        assert!(report
+            .history
+            .epochs
+            .iter()
+            .all(|e| e.valid_loss.is_finite() && e.valid_loss > 0.0));
+        let motion = synthetic_motion_phase(50, 4, 0.5);
+        let detector =
+            crate::spikes::SpikeDetector::load(&report.model, Default::default()).unwrap();
+        let p = detector.probabilities(&motion).unwrap();
+        assert_eq!(p.len(), 50 * report.description.joints.len());
+        assert!(p.iter().all(|v| (0.0..=1.0).contains(v)));
+        // Used as a denoiser, it is a clear error; a denoiser used as a
+        // detector too.
+        let as_denoiser = crate::infer::CleanModel::load(&report.model, Default::default())
+            .unwrap()
+            .clean(&motion, None)
+            .unwrap_err()
+            .to_string();
+        assert!(as_denoiser.contains("spike detector"), "{as_denoiser}");
+        let denoiser = train(&TrainOptions {
+            out: dir.path().join("denoiser.safetensors"),
+            ..tiny_setup(dir.path())
+        })
+        .unwrap();
+        let e = crate::spikes::SpikeDetector::load(&denoiser.model, Default::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a spike detector"), "{e}");
     }
 }

@@ -12,8 +12,9 @@ use mocap_clean::despike::DespikeOptions;
 use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
 use mocap_clean::features::{Representation, RotationFrame};
 use mocap_clean::filters::Filter;
-use mocap_clean::infer::{clean_file, CleanOptions, Method};
+use mocap_clean::infer::{clean_file, CleanOptions, FindSpikes, Method};
 use mocap_clean::model::DenoiserConfig;
+use mocap_clean::spikes::SpikeOptions;
 use mocap_clean::training::{train, TrainOptions};
 use mocap_nn::device::DeviceChoice;
 
@@ -68,6 +69,14 @@ struct TakeArgs {
     /// Spike finding: frames averaged on each side of a boundary.
     #[arg(long, requires = "despike")]
     despike_span: Option<usize>,
+    /// Before cleaning, find spikes (a joint and its subtree taking another motion's rotations) with
+    /// this learned detector, written by `mocap clean train --spike-detector`, and bridge them.
+    /// Experimental, none ships: see bench/results/clean.md.
+    #[arg(long, value_name = "FILE")]
+    spike_model: Option<PathBuf>,
+    /// Probability from which the detector's marks are bridged (default 0.5).
+    #[arg(long, requires = "spike_model")]
+    spike_threshold: Option<f32>,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
@@ -151,6 +160,10 @@ struct TrainArgs {
     /// Continue an interrupted run from its state folder.
     #[arg(long)]
     resume: bool,
+    /// Train a spike detector (for `mocap clean --spike-model`) instead of a denoiser:
+    /// the same network with one output per joint and frame, trained to mark the synthetic spikes.
+    #[arg(long, conflicts_with_all = ["base_filter", "position_weight"])]
+    spike_detector: bool,
     /// Training and validation curves as PNG (default: OUTPUT with extension png).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -180,6 +193,10 @@ struct EvalArgs {
     /// Also follow every method by spike finding (tuned per method on validation takes).
     #[arg(long)]
     despike: bool,
+    /// Also run this learned spike detector (from `mocap clean train --spike-detector`) alone and
+    /// before the first filter and every model.
+    #[arg(long, value_name = "FILE")]
+    spike_model: Option<PathBuf>,
     /// Evaluate every take, not only the test split (for data the models were not trained on).
     #[arg(long)]
     all_takes: bool,
@@ -233,6 +250,12 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         set(&mut d.span, a.despike_span);
         d
     });
+    let find_spikes = a.spike_model.map(|model| {
+        let mut options = SpikeOptions::default();
+        set(&mut options.threshold, a.spike_threshold);
+        FindSpikes { model, options }
+    });
+    let find_spikes_asked = find_spikes.is_some();
     let report = clean_file(&CleanOptions {
         input,
         output,
@@ -240,6 +263,7 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         device: a.device,
         hop: a.hop,
         despike,
+        find_spikes,
     })?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -252,6 +276,12 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.mean_change_deg,
             report.frames_per_second
         );
+        if find_spikes_asked {
+            eprintln!(
+                "spike detector: bridged {} spikes before cleaning",
+                report.detected_spikes.len()
+            );
+        }
         if a.despike {
             eprintln!("bridged {} spikes", report.spikes.len());
         }
@@ -269,6 +299,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         device: a.device,
         max_train_takes: a.max_train_takes,
         derivative_loss: a.loss == "derivative",
+        spike_detector: a.spike_detector,
         ..TrainOptions::default()
     };
     if a.large {
@@ -324,6 +355,10 @@ fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
     };
     o.random.perturb_above_pelvis = a.noise_above_pelvis;
     o.despike = a.despike;
+    o.spike_detector = a.spike_model.map(|path| ModelEntry {
+        label: "spike detector".into(),
+        path: Some(path),
+    });
     if a.no_default_model {
         o.models.retain(|m| m.path.is_some());
     }
