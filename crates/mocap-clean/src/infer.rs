@@ -260,6 +260,10 @@ pub enum Method {
     Model(PathBuf),
     /// A classical filter instead of a model.
     Filter(Filter),
+    /// No denoising: only the spike finding asked for (takes with little
+    /// random noise, which the shipped model would make worse; see
+    /// bench/results/clean.md, "Spikes alone").
+    SpikesOnly,
 }
 
 /// Options of `mocap clean IN -o OUT`.
@@ -329,6 +333,15 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
     };
     let detect_seconds = start.elapsed().as_secs_f64();
     let (cleaned, method, seconds) = match &options.method {
+        Method::SpikesOnly => {
+            if options.despike.is_none() && options.find_spikes.is_none() {
+                return Err(CleanError::Invalid(
+                    "spike finding only, but no spike finding asked for (despike or a spike model)"
+                        .into(),
+                ));
+            }
+            (motion.clone(), "spike finding only".to_string(), 0.0)
+        }
         Method::Filter(filter) => {
             let start = Instant::now();
             let out = filter_motion(&motion, filter)?;

@@ -100,6 +100,70 @@ fn clean_with_a_filter_and_bad_inputs() {
 }
 
 #[test]
+fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let output = dir.path().join("despiked.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--despike",
+        "--despike-only",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["method"], "spike finding only");
+    // A clean capture has no spikes to bridge: only what spike finding
+    // bridged changes, far less than the shipped model's change.
+    let despiked = mean_channel_change(Path::new(&input), &output);
+    let modelled = dir.path().join("modelled.bvh");
+    let out = mocap(&["clean", &input, "-o", path(&modelled), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let model_change = mean_channel_change(Path::new(&input), &modelled);
+    assert!(
+        despiked < 0.25 * model_change,
+        "despike only {despiked} vs model {model_change}"
+    );
+
+    // --despike-only needs --despike, and excludes a model or filter (usage errors).
+    let out = mocap(&["clean", &input, "-o", path(&output), "--despike-only"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--despike",
+        "--despike-only",
+        "--filter",
+        "median:3",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+
+    // A denoiser given as spike detector is an input error naming the file.
+    let model = mocap_testdata::repo_root().join("models/clean-default.safetensors");
+    let never = dir.path().join("never.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&never),
+        "--spike-model",
+        path(&model),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("not a spike detector"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!never.exists());
+}
+
+#[test]
 fn clean_train_writes_a_model_that_clean_can_use() {
     let Some(data) = mocap_testdata::shared_data() else {
         return;

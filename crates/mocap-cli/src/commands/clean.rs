@@ -63,6 +63,10 @@ struct TakeArgs {
     /// see bench/results/clean.md for what it gains and costs.
     #[arg(long)]
     despike: bool,
+    /// Only find and bridge spikes (with --despike), no denoising: for takes with little random
+    /// noise, which the shipped model makes worse (see bench/results/clean.md).
+    #[arg(long, requires = "despike", conflicts_with_all = ["model", "filter"])]
+    despike_only: bool,
     /// Spike finding: a boundary is a subtree jump this many times the joints' median jump.
     #[arg(long, requires = "despike")]
     despike_threshold: Option<f32>,
@@ -240,6 +244,7 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         bail!("mocap clean needs a take and -o OUTPUT");
     };
     let method = match (a.model, a.filter) {
+        _ if a.despike_only => Method::SpikesOnly,
         (Some(model), _) => Method::Model(model),
         (None, Some(filter)) => Method::Filter(filter),
         (None, None) => Method::DefaultModel,
