@@ -327,23 +327,24 @@ impl Cleaner {
     }
 }
 
-/// The spike detector's rows: alone, then before the first filter (the
-/// best family, Butterworth) and before every model.
-fn detector_rows(
-    detector: Option<&(String, Rc<SpikeDetector>)>,
+/// The cleaners of a condition: its tuned filters, the models, then the
+/// spike detector's rows (alone, then before the first filter, the best
+/// family, Butterworth, and before every model).
+fn cleaners_for(
     filters: &[(String, Cleaner)],
     models: &[(String, Cleaner)],
+    detector: Option<&(String, Rc<SpikeDetector>)>,
 ) -> Vec<(String, Cleaner)> {
-    let Some((label, d)) = detector else {
-        return Vec::new();
-    };
-    let spikes = Cleaner::Spikes(d.clone());
-    let mut rows = vec![(label.clone(), spikes.clone())];
-    for (name, c) in filters.iter().take(1).chain(models) {
-        rows.push((
-            format!("{label} + {name}"),
-            Cleaner::Then(Box::new(spikes.clone()), Box::new(c.clone())),
-        ));
+    let mut rows: Vec<_> = filters.iter().chain(models).cloned().collect();
+    if let Some((label, d)) = detector {
+        let spikes = Cleaner::Spikes(d.clone());
+        rows.push((label.clone(), spikes.clone()));
+        for (name, c) in filters.iter().take(1).chain(models) {
+            rows.push((
+                format!("{label} + {name}"),
+                Cleaner::Then(Box::new(spikes.clone()), Box::new(c.clone())),
+            ));
+        }
     }
     rows
 }
@@ -493,12 +494,8 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
 
     let mut entries = Vec::new();
     for (condition, filters) in per_condition.iter().enumerate() {
-        let detected = detector_rows(detector.as_ref(), filters, &models);
-        let cleaners: Vec<_> = filters
-            .iter()
-            .chain(models.iter())
-            .chain(detected.iter())
-            .collect();
+        let owned = cleaners_for(filters, &models, detector.as_ref());
+        let cleaners: Vec<_> = owned.iter().collect();
         let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
         let mut frames_total = 0usize;
@@ -541,12 +538,8 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     // the filters are those tuned for spikes alone.
     let mut spike_survival = Vec::new();
     let spike_filters = per_condition.get(SPIKES_ONLY).map_or(&[][..], |f| &f[..]);
-    let detected = detector_rows(detector.as_ref(), spike_filters, &models);
-    let cleaners: Vec<_> = spike_filters
-        .iter()
-        .chain(models.iter())
-        .chain(detected.iter())
-        .collect();
+    let owned = cleaners_for(spike_filters, &models, detector.as_ref());
+    let cleaners: Vec<_> = owned.iter().collect();
     let spike_methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
     for &length in &options.spike_lengths {
         let mut noisy_sum = 0.0;
