@@ -12,6 +12,7 @@
 //! Only rotations change: the output has the input's skeleton, channel
 //! layout and root translation.
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -322,14 +323,17 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         other => other,
     };
     let start = Instant::now();
+    // The take the method cleans: the input, or its copy with the detected
+    // spikes bridged.
     let (motion, detected_spikes) = match &options.find_spikes {
         Some(find) => {
             let detector = SpikeDetector::load(&find.model, options.device)?;
-            detector
+            let (bridged, found) = detector
                 .remove_spikes(&original, &find.options)
-                .map_err(in_file)?
+                .map_err(in_file)?;
+            (Cow::Owned(bridged), found)
         }
-        None => (original.clone(), Vec::new()),
+        None => (Cow::Borrowed(&original), Vec::new()),
     };
     let detect_seconds = start.elapsed().as_secs_f64();
     let (cleaned, method, seconds) = match &options.method {
@@ -340,7 +344,11 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                         .into(),
                 ));
             }
-            (motion.clone(), "spike finding only".to_string(), 0.0)
+            (
+                motion.as_ref().clone(),
+                "spike finding only".to_string(),
+                0.0,
+            )
         }
         Method::Filter(filter) => {
             let start = Instant::now();

@@ -40,6 +40,7 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::despike::FoundSpike;
+use crate::features::FeatureLayout;
 use crate::infer::CleanModel;
 use crate::model::Head;
 use crate::noise::Spike;
@@ -142,7 +143,11 @@ impl SpikeDetector {
     /// rotating joints. The network runs on the whole take at once, padded
     /// by repeating its first and last frames by half a training window.
     pub fn probabilities(&self, motion: &Motion) -> Result<Vec<f32>> {
-        let layout = self.model.layout_for(motion)?;
+        self.probabilities_on(motion, &self.model.layout_for(motion)?)
+    }
+
+    /// [`Self::probabilities`] with the rig's features already checked.
+    fn probabilities_on(&self, motion: &Motion, layout: &FeatureLayout) -> Result<Vec<f32>> {
         let (network, device) = self.model.network();
         let config = &self.model.description.network;
         let (c, joints) = (layout.channels(), layout.joints.len());
@@ -185,8 +190,9 @@ impl SpikeDetector {
         motion: &Motion,
         options: &SpikeOptions,
     ) -> Result<(Motion, Vec<FoundSpike>)> {
-        let p = self.probabilities(motion)?;
-        let joints = self.model.layout_for(motion)?.joints;
+        let layout = self.model.layout_for(motion)?;
+        let p = self.probabilities_on(motion, &layout)?;
+        let joints = layout.joints;
         Ok(bridge_marked(motion, &joints, &p, options))
     }
 }

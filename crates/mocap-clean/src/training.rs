@@ -809,9 +809,13 @@ mod tests {
             ..tiny_setup(dir.path())
         };
         let report = train(&options).unwrap();
-        // The base rate's cross-entropy is between 0 and ln 2 (share below
-        // one half), and so is every epoch's validation loss.
-        assert!(report.validation_input_mse > 0.0 && report.validation_input_mse < 0.7);
+        // The validation targets hold spikes: with an empty mask the base
+        // rate's cross-entropy would be ~0 (the share is clamped at 1e-9).
+        assert!(
+            report.validation_input_mse > 0.01,
+            "{}",
+            report.validation_input_mse
+        );
         assert!(report
             .history
             .epochs
