@@ -8,6 +8,10 @@
 //! - [`Filter::Butterworth`]: zero-phase low-pass (forward-backward
 //!   second-order sections, `sci-rs`'s port of SciPy's `butter` +
 //!   `sosfiltfilt`);
+//! - [`Filter::ButterworthGcv`]: the same low-pass with its cutoff chosen
+//!   per channel and per take by generalised cross-validation (Craven and
+//!   Wahba 1979), so that clean takes are left nearly alone and noisy ones
+//!   are smoothed hard;
 //! - [`Filter::SavitzkyGolay`]: local polynomial least squares (coefficients
 //!   from `sci-rs`'s `savgol_coeffs`, edges padded with the nearest frame);
 //! - [`Filter::Median`]: running median, the classical remedy for spikes;
@@ -29,6 +33,10 @@ pub enum Filter {
     /// Zero-phase Butterworth low-pass of `order` (applied forward and
     /// backward, so the effective order doubles) with cutoff in Hz.
     Butterworth { order: usize, cutoff_hz: f32 },
+    /// Zero-phase Butterworth low-pass of `order` whose cutoff is chosen for
+    /// each channel of each take among [`GCV_CUTOFFS_HZ`] by generalised
+    /// cross-validation (see [`gcv_trace_fraction`]).
+    ButterworthGcv { order: usize },
     /// Savitzky-Golay smoothing over an odd `window` of frames with a
     /// polynomial of degree `polyorder`.
     SavitzkyGolay { window: usize, polyorder: usize },
@@ -50,6 +58,7 @@ impl Filter {
             Filter::Butterworth { order, cutoff_hz } => {
                 format!("butterworth(order={order}, cutoff={cutoff_hz}Hz)")
             }
+            Filter::ButterworthGcv { order } => format!("butterworth-gcv(order={order})"),
             Filter::SavitzkyGolay { window, polyorder } => {
                 format!("savitzky-golay(window={window}, polyorder={polyorder})")
             }
@@ -68,6 +77,7 @@ impl Filter {
     pub fn family(&self) -> &'static str {
         match self {
             Filter::Butterworth { .. } => "butterworth",
+            Filter::ButterworthGcv { .. } => "butterworth-gcv",
             Filter::SavitzkyGolay { .. } => "savitzky-golay",
             Filter::Median { .. } => "median",
             Filter::OneEuro { .. } => "one-euro",
@@ -86,6 +96,18 @@ impl Filter {
                     return bad(format!(
                         "cutoff must be between 0 and the Nyquist frequency {} Hz",
                         0.5 * fps
+                    ));
+                }
+            }
+            Filter::ButterworthGcv { order } => {
+                if !(1..=8).contains(&order) {
+                    return bad("order must be 1 to 8".into());
+                }
+                if fps <= 2.0 * GCV_CUTOFFS_HZ[0] {
+                    return bad(format!(
+                        "needs a frame rate above {} fps (the lowest cutoff it tries is {} Hz)",
+                        2.0 * GCV_CUTOFFS_HZ[0],
+                        GCV_CUTOFFS_HZ[0]
                     ));
                 }
             }
@@ -116,6 +138,7 @@ impl Filter {
     pub fn apply_track(&self, track: &mut [f32], fps: f32) {
         match *self {
             Filter::Butterworth { order, cutoff_hz } => butterworth(track, order, cutoff_hz, fps),
+            Filter::ButterworthGcv { order } => butterworth_gcv(track, order, fps),
             Filter::SavitzkyGolay { window, polyorder } => savitzky_golay(track, window, polyorder),
             Filter::Median { window } => median(track, window),
             Filter::OneEuro {
@@ -138,6 +161,9 @@ impl Filter {
                     })
                 })
                 .collect(),
+            "butterworth-gcv" => [2, 4]
+                .map(|order| Filter::ButterworthGcv { order })
+                .to_vec(),
             "savitzky-golay" => [5, 7, 9, 11, 15, 21, 31]
                 .into_iter()
                 .flat_map(|w| {
@@ -165,13 +191,19 @@ impl Filter {
     }
 
     /// Every family name.
-    pub const FAMILIES: [&'static str; 4] = ["butterworth", "savitzky-golay", "median", "one-euro"];
+    pub const FAMILIES: [&'static str; 5] = [
+        "butterworth",
+        "butterworth-gcv",
+        "savitzky-golay",
+        "median",
+        "one-euro",
+    ];
 }
 
 impl std::str::FromStr for Filter {
     type Err = CleanError;
 
-    /// Parses `butterworth:ORDER:CUTOFF_HZ`, `savitzky-golay:WINDOW:POLYORDER`,
+    /// Parses `butterworth:ORDER:CUTOFF_HZ`, `butterworth-gcv:ORDER`, `savitzky-golay:WINDOW:POLYORDER`,
     /// `median:WINDOW` or `one-euro:MIN_CUTOFF_HZ:BETA:D_CUTOFF_HZ`.
     fn from_str(text: &str) -> Result<Filter> {
         let parts: Vec<&str> = text.split(':').collect();
@@ -195,6 +227,10 @@ impl std::str::FromStr for Filter {
                 count(2)?;
                 Filter::Butterworth { order: num(1)? as usize, cutoff_hz: num(2)? }
             }
+            "butterworth-gcv" => {
+                count(1)?;
+                Filter::ButterworthGcv { order: num(1)? as usize }
+            }
             "savitzky-golay" => {
                 count(2)?;
                 Filter::SavitzkyGolay { window: num(1)? as usize, polyorder: num(2)? as usize }
@@ -209,7 +245,7 @@ impl std::str::FromStr for Filter {
             }
             other => {
                 return Err(bad(format!(
-                    "unknown filter `{other}`: expected butterworth, savitzky-golay, median or one-euro"
+                    "unknown filter `{other}`: expected butterworth, butterworth-gcv, savitzky-golay, median or one-euro"
                 )))
             }
         };
@@ -243,6 +279,68 @@ pub fn filter_features(features: &mut [f32], channels: usize, filter: &Filter, f
             features[f * channels + ch] = track[f];
         }
     }
+}
+
+/// The cutoffs [`Filter::ButterworthGcv`] chooses from (those below the
+/// Nyquist frequency of the take).
+pub const GCV_CUTOFFS_HZ: [f32; 14] = [
+    0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0,
+];
+
+/// Low-passes `track` at the cutoff of [`GCV_CUTOFFS_HZ`] with the lowest
+/// generalised cross-validation score
+/// `GCV(c) = |x - H_c x|^2 / (1 - tr(H_c)/n)^2`: the residual of the
+/// smoother, inflated by how many degrees of freedom it keeps. Its minimum
+/// estimates the cutoff with the lowest error against the unknown clean
+/// signal when the noise is white (Craven and Wahba 1979), without knowing
+/// the noise level: a clean channel gets a high cutoff, a noisy one a low one.
+fn butterworth_gcv(track: &mut [f32], order: usize, fps: f32) {
+    let frames = track.len();
+    let mut best: Option<(f64, Vec<f32>)> = None;
+    for cutoff in GCV_CUTOFFS_HZ.into_iter().filter(|&c| c < 0.5 * fps) {
+        let mut smoothed = track.to_vec();
+        butterworth(&mut smoothed, order, cutoff, fps);
+        let residual: f64 = track
+            .iter()
+            .zip(&smoothed)
+            .map(|(&x, &y)| ((x - y) as f64).powi(2))
+            .sum();
+        let kept = gcv_trace_fraction(order, cutoff, fps, frames);
+        let score = residual / (1.0 - kept).powi(2);
+        if best.as_ref().is_none_or(|(b, _)| score < *b) {
+            best = Some((score, smoothed));
+        }
+    }
+    if let Some((_, smoothed)) = best {
+        track.copy_from_slice(&smoothed);
+    }
+}
+
+/// The share of a take's `frames` degrees of freedom that a zero-phase
+/// Butterworth low-pass of `order` and `cutoff_hz` keeps: `tr(H) / n` of the
+/// smoother `y = H x`, the term generalised cross-validation divides by.
+///
+/// Forward-backward filtering squares the filter's gain, so the smoother's
+/// frequency response is `G(w) = 1 / (1 + (tan(w/2) / tan(wc/2))^(2 order))`
+/// (the digital Butterworth by the bilinear transform with pre-warping, as
+/// SciPy's `butter` designs it), and `tr(H) / n` is the mean of `G` over the
+/// take's `n` DFT frequencies (exact for a circular filter; the edge padding
+/// changes it little).
+pub fn gcv_trace_fraction(order: usize, cutoff_hz: f32, fps: f32, frames: usize) -> f64 {
+    if frames == 0 {
+        return 0.0;
+    }
+    let n = frames as f64;
+    let tan_cut = (std::f64::consts::PI * cutoff_hz as f64 / fps as f64).tan();
+    let sum: f64 = (0..frames)
+        .map(|k| {
+            // Frequencies above Nyquist mirror those below.
+            let k = k.min(frames - k) as f64;
+            let ratio = (std::f64::consts::PI * k / n).tan() / tan_cut;
+            1.0 / (1.0 + ratio.powi(2 * order as i32))
+        })
+        .sum();
+    sum / n
 }
 
 fn butterworth(track: &mut [f32], order: usize, cutoff_hz: f32, fps: f32) {
@@ -367,6 +465,7 @@ mod tests {
                 polyorder: 2,
             },
             Filter::Median { window: 5 },
+            Filter::ButterworthGcv { order: 2 },
             Filter::OneEuro {
                 min_cutoff_hz: 4.0,
                 beta: 0.0,
@@ -405,6 +504,7 @@ mod tests {
                 polyorder: 2,
             },
             Filter::Median { window: 5 },
+            Filter::ButterworthGcv { order: 2 },
         ] {
             let mut track = line.clone();
             filter.apply_track(&mut track, 30.0);
@@ -441,6 +541,11 @@ mod tests {
             "median:9".parse::<Filter>().unwrap(),
             Filter::Median { window: 9 }
         );
+        assert_eq!(
+            "butterworth-gcv:4".parse::<Filter>().unwrap(),
+            Filter::ButterworthGcv { order: 4 }
+        );
+        assert!("butterworth-gcv:2:3".parse::<Filter>().is_err());
         assert!("median".parse::<Filter>().is_err());
         assert!("kalman:1".parse::<Filter>().is_err());
         assert!("one-euro:1:x:1".parse::<Filter>().is_err());
@@ -461,6 +566,8 @@ mod tests {
         .validate(30.0)
         .is_err());
         assert!(Filter::Median { window: 4 }.validate(30.0).is_err());
+        assert!(Filter::ButterworthGcv { order: 0 }.validate(30.0).is_err());
+        assert!(Filter::ButterworthGcv { order: 2 }.validate(1.0).is_err());
     }
 
     #[test]
@@ -479,5 +586,87 @@ mod tests {
         for f in 0..90 {
             assert_eq!(out.root_translation(f), motion.root_translation(f));
         }
+    }
+
+    /// A 0.7 Hz sine (30 fps) with white gaussian noise of `sigma`.
+    fn sine_with_white_noise(frames: usize, sigma: f32, seed: u64) -> (Vec<f32>, Vec<f32>) {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(seed);
+        let normal = Normal::new(0.0f32, sigma.max(1e-12)).unwrap();
+        let clean: Vec<f32> = (0..frames)
+            .map(|i| (2.0 * std::f32::consts::PI * 0.7 * i as f32 / 30.0).sin())
+            .collect();
+        let noisy = clean
+            .iter()
+            .map(|v| {
+                v + if sigma > 0.0 {
+                    normal.sample(&mut rng)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        (clean, noisy)
+    }
+
+    #[test]
+    fn gcv_smooths_noisy_tracks_hard_and_leaves_clean_ones_alone() {
+        let gcv = Filter::ButterworthGcv { order: 2 };
+        // No noise: the track comes back almost as it was (a fixed 2 Hz
+        // cutoff would not be far off here either, but a noisy-take setting
+        // like 1 Hz would be).
+        let (clean, _) = sine_with_white_noise(300, 0.0, 1);
+        let mut track = clean.clone();
+        gcv.apply_track(&mut track, 30.0);
+        assert!(rms(&clean, &track) < 0.01, "{}", rms(&clean, &track));
+        // With noise, GCV's error is near the best fixed cutoff's for that
+        // noise level, at two noise levels whose best cutoffs differ.
+        let mut best_cutoffs = Vec::new();
+        for sigma in [0.02, 0.5] {
+            let (clean, noisy) = sine_with_white_noise(300, sigma, 2);
+            let mut track = noisy.clone();
+            gcv.apply_track(&mut track, 30.0);
+            let chosen = rms(&clean, &track);
+            let (best_cutoff, best) = GCV_CUTOFFS_HZ
+                .iter()
+                .map(|&c| {
+                    let mut t = noisy.clone();
+                    butterworth(&mut t, 2, c, 30.0);
+                    (c, rms(&clean, &t))
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            best_cutoffs.push(best_cutoff);
+            assert!(
+                chosen < 1.3 * best,
+                "sigma {sigma}: GCV {chosen}, best fixed {best}"
+            );
+            assert!(chosen < 0.6 * rms(&clean, &noisy), "sigma {sigma}");
+        }
+        assert!(best_cutoffs[0] > best_cutoffs[1], "{best_cutoffs:?}");
+    }
+
+    #[test]
+    fn gcv_trace_fraction_matches_the_smoothers_impulse_responses() {
+        // tr(H) / n measured by filtering unit impulses, against the
+        // frequency-response formula.
+        let frames = 240;
+        for cutoff in [1.0, 3.0, 8.0] {
+            let mut trace = 0.0;
+            for i in 0..frames {
+                let mut impulse = vec![0.0f32; frames];
+                impulse[i] = 1.0;
+                butterworth(&mut impulse, 2, cutoff, 30.0);
+                trace += impulse[i] as f64;
+            }
+            let measured = trace / frames as f64;
+            let formula = gcv_trace_fraction(2, cutoff, 30.0, frames);
+            assert!(
+                (measured - formula).abs() < 0.1 * formula,
+                "{cutoff} Hz: impulses {measured}, formula {formula}"
+            );
+        }
+        assert!(gcv_trace_fraction(2, 1.0, 30.0, 240) < gcv_trace_fraction(2, 3.0, 30.0, 240));
     }
 }

@@ -27,6 +27,13 @@ fn path(p: &Path) -> &str {
 
 /// Mean absolute difference of the rotation channels of two takes with the
 /// same layout, in degrees.
+/// Mean geodesic angle between the local rotations of two takes (degrees):
+/// unlike channel values, blind to other Euler angles for the same rotation.
+fn rotation_change_deg(a: &Path, b: &Path) -> f32 {
+    mocap_core::metrics::mean_rotation_error_degrees(&read_bvh(a).unwrap(), &read_bvh(b).unwrap())
+        .unwrap()
+}
+
 fn mean_channel_change(a: &Path, b: &Path) -> f32 {
     let a = read_bvh(a).unwrap();
     let b = read_bvh(b).unwrap();
@@ -81,6 +88,26 @@ fn clean_with_a_filter_and_bad_inputs() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(mean_channel_change(Path::new(&input), &output) > 0.01);
+    let fixed_change = rotation_change_deg(Path::new(&input), &output);
+
+    // The cross-validated cutoff sees that this optical take is clean and
+    // changes it less than a fixed 3 Hz low-pass does.
+    let adaptive = dir.path().join("adaptive.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&adaptive),
+        "--filter",
+        "butterworth-gcv:2",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let adaptive_change = rotation_change_deg(Path::new(&input), &adaptive);
+    assert!(
+        adaptive_change < 0.5 * fixed_change,
+        "gcv {adaptive_change}, fixed {fixed_change}"
+    );
 
     // A filter spec that does not parse is a usage error (2).
     let out = mocap(&["clean", &input, "-o", path(&output), "--filter", "gauss:3"]);

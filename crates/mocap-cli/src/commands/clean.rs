@@ -50,7 +50,7 @@ struct TakeArgs {
     #[arg(long, conflicts_with = "filter")]
     model: Option<PathBuf>,
     /// A classical filter instead of a model: butterworth:ORDER:HZ,
-    /// savitzky-golay:WINDOW:POLYORDER, median:WINDOW or one-euro:MIN_HZ:BETA:D_HZ.
+    /// butterworth-gcv:ORDER (cutoff chosen per channel from the take itself), savitzky-golay:WINDOW:POLYORDER, median:WINDOW or one-euro:MIN_HZ:BETA:D_HZ.
     #[arg(long, value_name = "SPEC")]
     filter: Option<Filter>,
     /// cpu, or cuda[:N] in a build with the `cuda` feature.

@@ -1,0 +1,143 @@
+//! Study: how should the low-pass cutoff follow the noise level of a take?
+//!
+//! For validation takes with random noise of each given sigma, prints the
+//! mean rotation error of a zero-phase Butterworth (order 2) at every cutoff
+//! of a grid, of the best single cutoff per take (oracle), and of the cutoff
+//! chosen by generalised cross-validation (GCV) per take and per joint.
+//!
+//! cargo run --profile test -p mocap-clean --example cutoff_study -- DATA [TAKES] [SIGMAS]
+
+use std::path::PathBuf;
+
+use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
+use mocap_clean::eval::rotation_error_deg;
+use mocap_clean::features::{FeatureLayout, Representation};
+use mocap_clean::filters::{filter_features, gcv_trace_fraction, Filter};
+use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
+use rand::rngs::ChaCha8Rng;
+use rand::SeedableRng;
+use rayon::prelude::*;
+
+const CUTOFFS: [f32; 13] = [
+    0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0,
+];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let data = PathBuf::from(args.first().ok_or("DATA folder needed")?);
+    let max_takes: usize = args.get(1).map_or(Ok(40), |s| s.parse())?;
+    let sigmas: Vec<f32> = args
+        .get(2)
+        .map_or("0,1,2,4,6,8,10", String::as_str)
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()?;
+    let paths = paths_in_split(
+        &list_bvh(&[data])?,
+        Split::Validation,
+        &SplitFractions::default(),
+    );
+    let takes = load_takes(&paths[..max_takes.min(paths.len())])?;
+    println!(
+        "{} validation takes; Butterworth order 2; mean rotation error (deg)",
+        takes.len()
+    );
+    print!("| sigma | input |");
+    for c in CUTOFFS {
+        print!(" {c} Hz |");
+    }
+    println!(" oracle per take | GCV per take | GCV per joint | GCV per channel | butterworth-gcv:2 | the same on 32-frame windows |");
+    for &sigma in &sigmas {
+        let rows: Vec<Vec<f64>> = takes
+            .par_iter()
+            .enumerate()
+            .map(|(i, take)| {
+                let mut rng = ChaCha8Rng::seed_from_u64(1000 + i as u64);
+                let clean = &take.motion;
+                let noisy = add_random_noise_sigma(clean, sigma, &RandomNoise::default(), &mut rng);
+                let fps = noisy.fps() as f32;
+                let layout = FeatureLayout::new(noisy.skeleton(), Representation::Rot6d).unwrap();
+                let x = layout.encode(&noisy);
+                let channels = layout.channels();
+                let frames = noisy.frame_count();
+                let mut row = vec![rotation_error_deg(clean, &noisy)];
+                let mut filtered = Vec::new();
+                for c in CUTOFFS {
+                    let mut y = x.clone();
+                    let f = Filter::Butterworth {
+                        order: 2,
+                        cutoff_hz: c,
+                    };
+                    filter_features(&mut y, channels, &f, fps);
+                    let mut out = noisy.clone();
+                    layout.decode_into(&y, &mut out);
+                    row.push(rotation_error_deg(clean, &out));
+                    filtered.push(y);
+                }
+                let oracle = row[1..].iter().cloned().fold(f64::INFINITY, f64::min);
+                row.push(oracle);
+                let dim = 6;
+                let gcv = |k: usize, ch: std::ops::Range<usize>| {
+                    let y = &filtered[k];
+                    let mut rss = 0.0f64;
+                    for f in 0..frames {
+                        for c in ch.clone() {
+                            let d = (x[f * channels + c] - y[f * channels + c]) as f64;
+                            rss += d * d;
+                        }
+                    }
+                    let t = gcv_trace_fraction(2, CUTOFFS[k], fps, frames);
+                    rss / (1.0 - t).powi(2)
+                };
+                let pick = |ch: std::ops::Range<usize>| {
+                    (0..CUTOFFS.len())
+                        .min_by(|&a, &b| gcv(a, ch.clone()).total_cmp(&gcv(b, ch.clone())))
+                        .unwrap()
+                };
+                let whole = pick(0..channels);
+                row.push(row[1 + whole]);
+                let mut mixed = x.clone();
+                for k in 0..layout.joints.len() {
+                    let best = pick(k * dim..(k + 1) * dim);
+                    for f in 0..frames {
+                        for c in k * dim..(k + 1) * dim {
+                            mixed[f * channels + c] = filtered[best][f * channels + c];
+                        }
+                    }
+                }
+                let mut out = noisy.clone();
+                layout.decode_into(&mixed, &mut out);
+                row.push(rotation_error_deg(clean, &out));
+                for c in 0..channels {
+                    let best = pick(c..c + 1);
+                    for f in 0..frames {
+                        mixed[f * channels + c] = filtered[best][f * channels + c];
+                    }
+                }
+                layout.decode_into(&mixed, &mut out);
+                row.push(rotation_error_deg(clean, &out));
+                // The filter itself, on the whole take and on separate
+                // 32-frame windows (as a model's base filter runs).
+                let gcv_filter = Filter::ButterworthGcv { order: 2 };
+                let mut y = x.clone();
+                filter_features(&mut y, channels, &gcv_filter, fps);
+                layout.decode_into(&y, &mut out);
+                row.push(rotation_error_deg(clean, &out));
+                let mut y = x.clone();
+                for chunk in y.chunks_mut(32 * channels) {
+                    filter_features(chunk, channels, &gcv_filter, fps);
+                }
+                layout.decode_into(&y, &mut out);
+                row.push(rotation_error_deg(clean, &out));
+                row
+            })
+            .collect();
+        let n = rows.len() as f64;
+        print!("| {sigma} |");
+        for k in 0..rows[0].len() {
+            print!(" {:.3} |", rows.iter().map(|r| r[k]).sum::<f64>() / n);
+        }
+        println!();
+    }
+    Ok(())
+}
