@@ -3,7 +3,9 @@
 //! For validation takes with random noise of each given sigma, prints the
 //! mean rotation error of a zero-phase Butterworth (order 2) at every cutoff
 //! of a grid, of the best single cutoff per take (oracle), and of the cutoff
-//! chosen by generalised cross-validation (GCV) per take and per joint.
+//! chosen by generalised cross-validation (GCV) per take, per joint, and per
+//! channel (`butterworth-gcv:2`, on the whole take and on separate 32-frame
+//! windows).
 //!
 //! cargo run --profile test -p mocap-clean --example cutoff_study -- DATA [TAKES] [SIGMAS]
 
@@ -12,7 +14,7 @@ use std::path::PathBuf;
 use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
-use mocap_clean::filters::{filter_features, gcv_trace_fraction, Filter};
+use mocap_clean::filters::{filter_features, gcv_score, gcv_trace_fraction, Filter};
 use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
@@ -46,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for c in CUTOFFS {
         print!(" {c} Hz |");
     }
-    println!(" oracle per take | GCV per take | GCV per joint | GCV per channel | butterworth-gcv:2 | the same on 32-frame windows |");
+    println!(" oracle per take | GCV per take | GCV per joint | butterworth-gcv:2 (GCV per channel) | the same on 32-frame windows |");
     for &sigma in &sigmas {
         let rows: Vec<Vec<f64>> = takes
             .par_iter()
@@ -77,7 +79,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let oracle = row[1..].iter().cloned().fold(f64::INFINITY, f64::min);
                 row.push(oracle);
                 let dim = 6;
-                let gcv = |k: usize, ch: std::ops::Range<usize>| {
+                // GCV (`mocap_clean::filters::gcv_score`) of cutoff `k` over
+                // the channels `ch`, for choices coarser than the filter's
+                // own per-channel one.
+                let score = |k: usize, ch: std::ops::Range<usize>| {
                     let y = &filtered[k];
                     let mut rss = 0.0f64;
                     for f in 0..frames {
@@ -86,12 +91,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             rss += d * d;
                         }
                     }
-                    let t = gcv_trace_fraction(2, CUTOFFS[k], fps, frames);
-                    rss / (1.0 - t).powi(2)
+                    gcv_score(rss, gcv_trace_fraction(2, CUTOFFS[k], fps, frames))
                 };
                 let pick = |ch: std::ops::Range<usize>| {
                     (0..CUTOFFS.len())
-                        .min_by(|&a, &b| gcv(a, ch.clone()).total_cmp(&gcv(b, ch.clone())))
+                        .map(|k| (k, score(k, ch.clone())))
+                        .min_by(|a, b| a.1.total_cmp(&b.1))
+                        .map(|(k, _)| k)
                         .unwrap()
                 };
                 let whole = pick(0..channels);
@@ -106,14 +112,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                 }
                 let mut out = noisy.clone();
-                layout.decode_into(&mixed, &mut out);
-                row.push(rotation_error_deg(clean, &out));
-                for c in 0..channels {
-                    let best = pick(c..c + 1);
-                    for f in 0..frames {
-                        mixed[f * channels + c] = filtered[best][f * channels + c];
-                    }
-                }
                 layout.decode_into(&mixed, &mut out);
                 row.push(rotation_error_deg(clean, &out));
                 // The filter itself, on the whole take and on separate

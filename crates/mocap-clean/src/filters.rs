@@ -305,8 +305,7 @@ fn butterworth_gcv(track: &mut [f32], order: usize, fps: f32) {
             .zip(&smoothed)
             .map(|(&x, &y)| ((x - y) as f64).powi(2))
             .sum();
-        let kept = gcv_trace_fraction(order, cutoff, fps, frames);
-        let score = residual / (1.0 - kept).powi(2);
+        let score = gcv_score(residual, gcv_trace_fraction(order, cutoff, fps, frames));
         if best.as_ref().is_none_or(|(b, _)| score < *b) {
             best = Some((score, smoothed));
         }
@@ -314,6 +313,13 @@ fn butterworth_gcv(track: &mut [f32], order: usize, fps: f32) {
     if let Some((_, smoothed)) = best {
         track.copy_from_slice(&smoothed);
     }
+}
+
+/// The generalised cross-validation score of a smoother from the sum of
+/// squared residuals `|x - H x|^2` and the share of degrees of freedom it
+/// keeps, `tr(H) / n` ([`gcv_trace_fraction`]): lower is better.
+pub fn gcv_score(residual_sum_of_squares: f64, kept_fraction: f64) -> f64 {
+    residual_sum_of_squares / (1.0 - kept_fraction).powi(2)
 }
 
 /// The share of a take's `frames` degrees of freedom that a zero-phase
