@@ -123,6 +123,24 @@ pub fn window(motion: &Motion, start: usize, frames: usize) -> Motion {
     .expect("a window of a valid motion is valid")
 }
 
+/// `frames` frames of `motion` from `start` on, starting over at its first
+/// frame when it ends: spike donors as long as the motion they spike, taken
+/// from a shorter take.
+pub fn looped_window(motion: &Motion, start: usize, frames: usize) -> Motion {
+    let n = motion.frame_count().max(1);
+    let mut values = Vec::with_capacity(frames * motion.skeleton().channel_count());
+    for f in 0..frames {
+        values.extend_from_slice(motion.frame((start + f) % n));
+    }
+    Motion::new(
+        motion.skeleton().clone(),
+        motion.frame_time(),
+        frames,
+        values,
+    )
+    .expect("frames of a valid motion make a valid motion")
+}
+
 /// What a model was trained on, stored in its checkpoint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DataDescription {
@@ -167,5 +185,15 @@ mod tests {
         assert_eq!(w.frame_count(), 5);
         assert_eq!(w.frame(0), m.frame(10));
         assert_eq!(w.frame(4), m.frame(14));
+    }
+
+    #[test]
+    fn looped_windows_start_over() {
+        let m = crate::test_support::synthetic_motion(30, 4);
+        let w = looped_window(&m, 25, 10);
+        assert_eq!(w.frame_count(), 10);
+        assert_eq!(w.frame(4), m.frame(29));
+        assert_eq!(w.frame(5), m.frame(0));
+        assert_eq!(w.frame(9), m.frame(4));
     }
 }

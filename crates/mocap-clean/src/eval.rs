@@ -34,7 +34,9 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions, Take};
+use crate::dataset::{
+    list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions, Take,
+};
 use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::CleanModel;
@@ -223,12 +225,7 @@ fn donor_windows(takes: &[Take], skip: usize, frames: usize, rng: &mut ChaCha8Rn
         {
             continue;
         }
-        let c = m.skeleton().channel_count();
-        let mut values = Vec::with_capacity(frames * c);
-        for f in 0..frames {
-            values.extend_from_slice(m.frame(f % m.frame_count()));
-        }
-        out.push(Motion::new(m.skeleton().clone(), m.frame_time(), frames, values).expect("valid"));
+        out.push(looped_window(m, 0, frames));
     }
     out
 }

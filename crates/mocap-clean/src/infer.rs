@@ -156,16 +156,31 @@ impl CleanModel {
             return Ok(motion.clone());
         }
         let features = layout.encode(motion);
+        // A base filter that sees the whole take runs once, before the take
+        // is cut into windows (see `ModelDescription::base_context`).
+        let filtered_take = match &self.description.base_filter {
+            Some(filter) if self.description.base_context > 0 => {
+                let mut filtered = features.clone();
+                filter_features(&mut filtered, c, filter, self.description.fps);
+                Some(filtered)
+            }
+            _ => None,
+        };
         // Pad by repeating the edge frames: half a window in front, and at
         // the end enough for the last window to be whole.
         let front = t / 2;
         let windows = (frames + front).div_ceil(hop).max(1);
         let padded_len = (windows - 1) * hop + t;
-        let mut padded = Vec::with_capacity(padded_len * c);
-        for i in 0..padded_len {
-            let f = (i as isize - front as isize).clamp(0, frames as isize - 1) as usize;
-            padded.extend_from_slice(&features[f * c..(f + 1) * c]);
-        }
+        let pad = |features: &[f32]| {
+            let mut padded = Vec::with_capacity(padded_len * c);
+            for i in 0..padded_len {
+                let f = (i as isize - front as isize).clamp(0, frames as isize - 1) as usize;
+                padded.extend_from_slice(&features[f * c..(f + 1) * c]);
+            }
+            padded
+        };
+        let padded = pad(&features);
+        let padded_filtered = filtered_take.as_deref().map(pad);
         let weight: Vec<f32> = (0..t)
             .map(|k| {
                 (std::f32::consts::PI * (k as f32 + 0.5) / t as f32)
@@ -186,10 +201,22 @@ impl CleanModel {
             for b in 0..n {
                 let s = (start_index + b) * hop;
                 let mut w = padded[s * c..(s + t) * c].to_vec();
-                offsets.push(layout.recenter(&mut w));
-                if let Some(filter) = &self.description.base_filter {
-                    let mut filtered = w.clone();
-                    filter_features(&mut filtered, c, filter, self.description.fps);
+                let recentering = layout.recenter(&mut w);
+                let filtered = match (&padded_filtered, &self.description.base_filter) {
+                    (Some(take), _) => {
+                        let mut filtered = take[s * c..(s + t) * c].to_vec();
+                        recentering.apply(&mut filtered);
+                        Some(filtered)
+                    }
+                    (None, Some(filter)) => {
+                        let mut filtered = w.clone();
+                        filter_features(&mut filtered, c, filter, self.description.fps);
+                        Some(filtered)
+                    }
+                    (None, None) => None,
+                };
+                offsets.push(recentering);
+                if let Some(filtered) = filtered {
                     base_corrections.push(
                         filtered
                             .iter()
@@ -410,6 +437,7 @@ mod tests {
             joints: (0..joints).map(|j| format!("j{j}")).collect(),
             fps: 30.0,
             base_filter: None,
+            base_context: 0,
         };
         let header = CheckpointHeader {
             kind: CHECKPOINT_KIND.into(),

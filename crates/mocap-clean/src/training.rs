@@ -31,8 +31,8 @@ use rand::{Rng, RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{
-    list_bvh, load_takes, paths_in_split, split_of, take_name, window, DataDescription, Split,
-    SplitFractions, Take,
+    list_bvh, load_takes, looped_window, paths_in_split, split_of, take_name, window,
+    DataDescription, Split, SplitFractions, Take,
 };
 use crate::features::{FeatureLayout, Representation, RotationFrame};
 use crate::filters::{filter_features, Filter};
@@ -68,10 +68,18 @@ pub struct ModelDescription {
     /// output is `base(x) + (N(x) - x)` instead of `N(x)` (`N` has a global
     /// skip, so `N(x) - x` is its correction). At the start of training the
     /// correction is near zero and the model is as good as the filter;
-    /// training learns what the filter gets wrong. Filtered per window, in
-    /// training and in use alike. `None`: the report's model.
+    /// training learns what the filter gets wrong. `None`: the report's
+    /// model.
     #[serde(default)]
     pub base_filter: Option<Filter>,
+    /// How much of the take the base filter sees. `0` (models written before
+    /// this field): each window alone, in training and in use alike. `N > 0`:
+    /// in use the filter runs once over the whole take; in training over the
+    /// window and up to `N` frames of its take on each side, so that a filter
+    /// that adapts to what it sees (`butterworth-gcv`, whose cutoff chosen on
+    /// a 32-frame window is poor) is trained with nearly what it sees in use.
+    #[serde(default)]
+    pub base_context: usize,
 }
 
 /// Options of `mocap clean train`.
@@ -92,6 +100,9 @@ pub struct TrainOptions {
     /// See [`ModelDescription::base_filter`].
     #[serde(default)]
     pub base_filter: Option<Filter>,
+    /// See [`ModelDescription::base_context`].
+    #[serde(default)]
+    pub base_context: usize,
     /// Network sizes; `channels` is set from the data.
     pub network: DenoiserConfig,
     pub epochs: usize,
@@ -136,6 +147,7 @@ impl Default for TrainOptions {
             representation: Representation::Rot6d,
             frame: RotationFrame::Local,
             base_filter: None,
+            base_context: 0,
             network: DenoiserConfig::small(0),
             epochs: 20,
             steps_per_epoch: 40,
@@ -190,6 +202,9 @@ pub struct WindowSampler<'a> {
     /// The base filter of the model and the frame rate (see
     /// [`ModelDescription::base_filter`]).
     base: Option<(Filter, f32)>,
+    /// Frames of the take the noise and the base filter see on each side of
+    /// the window ([`ModelDescription::base_context`]).
+    context: usize,
     /// Targets are spike masks (one value per joint and frame) instead of
     /// the clean features.
     spike_targets: bool,
@@ -226,14 +241,19 @@ impl<'a> WindowSampler<'a> {
             frames,
             noise,
             base: None,
+            context: 0,
             spike_targets: false,
         })
     }
 
     /// Targets for a model whose output is added to `base` run on its
-    /// input (see [`ModelDescription::base_filter`]).
-    pub fn with_base_filter(mut self, base: Option<Filter>, fps: f32) -> Self {
+    /// input, with `context` frames of the take on each side of the window
+    /// (see [`ModelDescription::base_filter`] and
+    /// [`ModelDescription::base_context`]). The noise is then added to the
+    /// window with its context, as it is added to whole takes in use.
+    pub fn with_base_filter(mut self, base: Option<Filter>, fps: f32, context: usize) -> Self {
         self.base = base.map(|f| (f, fps));
+        self.context = if self.base.is_some() { context } else { 0 };
         self
     }
 
@@ -267,25 +287,47 @@ impl<'a> WindowSampler<'a> {
         Ok((noisy, clean))
     }
 
-    /// One clean window, its noisy copy and the spikes added to it.
+    /// One clean window, its noisy copy and the spikes added to it (frames
+    /// counted from the window's start; with a context, the spikes that
+    /// touch the window, cut to it).
     pub fn sample_with_spikes<R: Rng + ?Sized>(
         &self,
         rng: &mut R,
     ) -> Result<(Motion, Motion, Vec<Spike>)> {
+        let stretch = self.sample_stretch(rng)?;
+        let (at, t) = (stretch.window_start, self.frames);
+        Ok((
+            window(&stretch.noisy, at, t),
+            window(&stretch.clean, at, t),
+            spikes_in_window(&stretch.spikes, at, t),
+        ))
+    }
+
+    /// A window with up to `context` frames of its take on each side (as
+    /// many as the take has), clean and noisy.
+    fn sample_stretch<R: Rng + ?Sized>(&self, rng: &mut R) -> Result<Stretch> {
         let (t, start) = self.pick(rng);
-        let clean = window(&self.takes[t].motion, start, self.frames);
-        // Spike donors: windows of other takes.
+        let take = &self.takes[t].motion;
+        let first = start.saturating_sub(self.context);
+        let end = (start + self.frames + self.context).min(take.frame_count());
+        let clean = window(take, first, end - first);
+        // Spike donors: stretches of other takes, as long as this one.
         let mut donors = Vec::new();
         for _ in 0..self.noise.spikes.map_or(0, |s| s.max_spikes.max(1)) {
             let (mut d, mut s) = self.pick(rng);
             while d == t {
                 (d, s) = self.pick(rng);
             }
-            donors.push(window(&self.takes[d].motion, s, self.frames));
+            donors.push(looped_window(&self.takes[d].motion, s, end - first));
         }
         let donor_refs: Vec<&Motion> = donors.iter().collect();
         let (noisy, spikes) = add_noise_with_spikes(&clean, &donor_refs, &self.noise, rng)?;
-        Ok((noisy, clean, spikes))
+        Ok(Stretch {
+            noisy,
+            clean,
+            spikes,
+            window_start: start - first,
+        })
     }
 
     /// A batch as `[batch, channels, frames]` tensor data (noisy, clean), or
@@ -303,24 +345,43 @@ impl<'a> WindowSampler<'a> {
             .par_iter()
             .map(|&seed| {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
-                let (noisy, clean, spikes) = self.sample_with_spikes(&mut rng)?;
-                let mut xf = self.layout.encode(&noisy);
                 if self.spike_targets {
+                    let (noisy, clean, spikes) = self.sample_with_spikes(&mut rng)?;
+                    let mut xf = self.layout.encode(&noisy);
                     self.layout.recenter(&mut xf);
                     let mask = spike_mask(&clean, &noisy, &self.layout.joints, &spikes);
                     return Ok((xf, mask));
                 }
-                let mut yf = self.layout.encode(&clean);
+                let stretch = self.sample_stretch(&mut rng)?;
+                let xs = self.layout.encode(&stretch.noisy);
+                let mut ys = self.layout.encode(&stretch.clean);
                 // Euler angles and exponential maps: the target on the
                 // input's branch, then both brought to the canonical range
                 // the same way (see `FeatureLayout::align_target`).
-                self.layout.align_target(&xf, &mut yf);
-                self.layout.recenter(&mut xf).apply(&mut yf);
+                self.layout.align_target(&xs, &mut ys);
+                let crop = |v: &[f32]| {
+                    v[stretch.window_start * c..(stretch.window_start + t) * c].to_vec()
+                };
+                let (mut xf, mut yf) = (crop(&xs), crop(&ys));
+                let recentering = self.layout.recenter(&mut xf);
+                recentering.apply(&mut yf);
                 if let Some((filter, fps)) = &self.base {
+                    // As in use (`CleanModel::clean`): with a context the
+                    // filter runs on the whole stretch before the window is
+                    // cut and recentred, without one on the recentred window.
+                    let filtered = if self.context > 0 {
+                        let mut filtered = xs.clone();
+                        filter_features(&mut filtered, c, filter, *fps);
+                        let mut filtered = crop(&filtered);
+                        recentering.apply(&mut filtered);
+                        filtered
+                    } else {
+                        let mut filtered = xf.clone();
+                        filter_features(&mut filtered, c, filter, *fps);
+                        filtered
+                    };
                     // The network's output N(x) stands for y - base(x) + x,
                     // so that the model's output N(x) - x + base(x) is y.
-                    let mut filtered = xf.clone();
-                    filter_features(&mut filtered, c, filter, *fps);
                     for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&filtered) {
                         *y += x - b;
                     }
@@ -342,6 +403,35 @@ impl<'a> WindowSampler<'a> {
         }
         Ok((x, y))
     }
+}
+
+/// The parts of `spikes` within frames `start..start + frames`, counted from
+/// `start`.
+fn spikes_in_window(spikes: &[Spike], start: usize, frames: usize) -> Vec<Spike> {
+    let end = start + frames;
+    spikes
+        .iter()
+        .filter(|s| s.start < end && s.start + s.frames > start)
+        .map(|s| {
+            let first = s.start.max(start);
+            Spike {
+                start: first - start,
+                frames: (s.start + s.frames).min(end) - first,
+                ..*s
+            }
+        })
+        .collect()
+}
+
+/// A window of a take with its context, clean and noisy (see
+/// [`WindowSampler::sample_stretch`]).
+struct Stretch {
+    noisy: Motion,
+    clean: Motion,
+    /// The spikes added, frames counted from the stretch's start.
+    spikes: Vec<Spike>,
+    /// Where the window starts in the stretch.
+    window_start: usize,
 }
 
 fn tensor(data: Vec<f32>, shape: [usize; 3], device: &Device) -> Tensor<3> {
@@ -420,6 +510,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         joints,
         fps,
         base_filter: options.base_filter,
+        base_context: if options.base_filter.is_some() {
+            options.base_context
+        } else {
+            0
+        },
     };
     let loss = if options.derivative_loss {
         LossWeights::derivative(fps)
@@ -462,10 +557,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         None
     };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps)
+        .with_base_filter(options.base_filter, fps, options.base_context)
         .with_spike_targets(options.spike_detector);
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps)
+        .with_base_filter(options.base_filter, fps, options.base_context)
         .with_spike_targets(options.spike_detector);
     let shape = [options.batch_size, network.channels, network.window];
     let target_shape = [
@@ -750,7 +845,7 @@ mod tests {
         let plain = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default()).unwrap();
         let based = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default())
             .unwrap()
-            .with_base_filter(Some(filter), 30.0);
+            .with_base_filter(Some(filter), 30.0, 0);
         let (x1, y1) = plain.batch(&mut ChaCha8Rng::seed_from_u64(1), 4).unwrap();
         let (x2, y2) = based.batch(&mut ChaCha8Rng::seed_from_u64(1), 4).unwrap();
         assert_eq!(x1, x2);
@@ -779,6 +874,96 @@ mod tests {
     }
 
     #[test]
+    fn spikes_are_cut_to_the_window() {
+        let spike = |joint, start, frames| Spike {
+            joint,
+            start,
+            frames,
+        };
+        let spikes = [
+            spike(1, 0, 5),   // ends before the window
+            spike(2, 8, 4),   // starts before it
+            spike(3, 12, 3),  // inside
+            spike(4, 18, 10), // ends after it
+            spike(5, 20, 2),  // starts after it
+        ];
+        assert_eq!(
+            spikes_in_window(&spikes, 10, 10),
+            vec![spike(2, 0, 2), spike(3, 2, 3), spike(4, 8, 2)]
+        );
+    }
+
+    /// With a context the base filter runs on the window's take around it,
+    /// as in use on the whole take; without one on the window alone.
+    #[test]
+    fn a_base_context_filters_the_take_around_the_window() {
+        let takes: Vec<Take> = (0..3)
+            .map(|i| Take {
+                name: format!("take_{i}"),
+                path: PathBuf::new(),
+                motion: synthetic_motion_phase(40, 4, i as f32),
+            })
+            .collect();
+        let layout = FeatureLayout::new(takes[0].motion.skeleton(), Representation::Rot6d).unwrap();
+        let filter = Filter::Butterworth {
+            order: 2,
+            cutoff_hz: 2.0,
+        };
+        // No noise: the input window is a window of a take, and the target
+        // is y + x - base = 2x - base.
+        let no_noise = NoiseConfig {
+            random: None,
+            spikes: None,
+            spike_probability: 0.0,
+        };
+        let (c, t) = (layout.channels(), 16);
+        let filtered_takes: Vec<Vec<f32>> = takes
+            .iter()
+            .map(|take| {
+                let mut f = layout.encode(&take.motion);
+                filter_features(&mut f, c, &filter, 30.0);
+                f
+            })
+            .collect();
+        // The largest gap between the implied base of each sample and the
+        // filtered take at the same frames.
+        let gap_to_the_filtered_take = |context: usize| {
+            let sampler = WindowSampler::new(&takes, &layout, t, no_noise)
+                .unwrap()
+                .with_base_filter(Some(filter), 30.0, context);
+            let (x, y) = sampler.batch(&mut ChaCha8Rng::seed_from_u64(3), 8).unwrap();
+            let mut gap = 0.0f32;
+            for b in 0..8 {
+                let frame_major = |v: &[f32]| -> Vec<f32> {
+                    (0..t)
+                        .flat_map(|f| (0..c).map(move |ch| (f, ch)))
+                        .map(|(f, ch)| v[(b * c + ch) * t + f])
+                        .collect()
+                };
+                let (xw, yw) = (frame_major(&x), frame_major(&y));
+                let (take, start) = (0..takes.len())
+                    .flat_map(|k| (0..=40 - t).map(move |s| (k, s)))
+                    .find(|&(k, s)| {
+                        let features = layout.encode(&takes[k].motion);
+                        features[s * c..(s + t) * c]
+                            .iter()
+                            .zip(&xw)
+                            .all(|(a, b)| (a - b).abs() < 1e-6)
+                    })
+                    .expect("a noiseless window is a window of a take");
+                let base = &filtered_takes[take][start * c..(start + t) * c];
+                for i in 0..xw.len() {
+                    gap = gap.max((2.0 * xw[i] - yw[i] - base[i]).abs());
+                }
+            }
+            gap
+        };
+        assert!(gap_to_the_filtered_take(40) < 1e-5);
+        // Filtering the window alone differs at its borders.
+        assert!(gap_to_the_filtered_take(0) > 1e-3);
+    }
+
+    #[test]
     fn a_model_with_a_base_filter_trains_and_cleans() {
         let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();
@@ -797,6 +982,41 @@ mod tests {
         let cleaned = model.clean(&motion, None).unwrap();
         assert!(cleaned.values().iter().all(|v| v.is_finite()));
         assert_eq!(cleaned.frame_count(), 50);
+    }
+
+    #[test]
+    fn a_model_with_a_base_context_filters_whole_takes() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let options = TrainOptions {
+            out: dir.path().join("context.safetensors"),
+            base_filter: Some(Filter::ButterworthGcv { order: 2 }),
+            base_context: 16,
+            ..tiny_setup(dir.path())
+        };
+        let report = train(&options).unwrap();
+        let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        assert_eq!(model.description.base_context, 16);
+        let mut motion = synthetic_motion_phase(50, 4, 0.5);
+        let noise = NoiseConfig {
+            spikes: None,
+            ..NoiseConfig::default()
+        };
+        motion = crate::noise::add_noise(&motion, &[], &noise, &mut ChaCha8Rng::seed_from_u64(2))
+            .unwrap();
+        let whole_take = model.clean(&motion, None).unwrap();
+        assert!(whole_take.values().iter().all(|v| v.is_finite()));
+        // The same weights with the filter run per window give another
+        // answer: the context is used in cleaning.
+        model.description.base_context = 0;
+        let per_window = model.clean(&motion, None).unwrap();
+        let most = whole_take
+            .values()
+            .iter()
+            .zip(per_window.values())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(most > 1e-3, "{most}");
     }
 
     #[test]

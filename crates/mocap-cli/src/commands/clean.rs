@@ -121,6 +121,11 @@ struct TrainArgs {
     /// instead of correcting its input (see bench/results/clean.md).
     #[arg(long, value_name = "SPEC")]
     base_filter: Option<Filter>,
+    /// With --base-filter: frames of the take the filter sees on each side of a training window;
+    /// the trained model then filters whole takes at once (for `butterworth-gcv`, whose cutoff
+    /// needs a long stretch to be chosen well). 0: each window alone.
+    #[arg(long, value_name = "FRAMES", requires = "base_filter")]
+    base_context: Option<usize>,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -318,6 +323,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.representation, a.representation);
     set(&mut o.frame, a.rotations);
     o.base_filter = a.base_filter;
+    set(&mut o.base_context, a.base_context);
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
     set(&mut o.network.levels, a.levels);

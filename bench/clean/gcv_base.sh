@@ -1,0 +1,21 @@
+#!/bin/bash
+# The network on top of the cross-validated Butterworth (bench/results/clean.md, "The network on top of the
+# cross-validated Butterworth"): the shipped model's recipe (width 64, 32-frame windows, derivative loss,
+# 12 epochs x 40 steps x 256 windows, lr 1e-3, seed 1, default noise) with --base-filter butterworth-gcv:2 and
+# --base-context 128 (noise and filter on the window plus up to 128 frames of its take on each side; in use the
+# filter runs over the whole take). Then the 116-take evaluation with the tuned filters, the shipped model and it.
+# Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
+set -e
+cd "$(dirname "$0")/../.."
+BIN=./target-clean/debug/examples
+DATA=../shared/data/bandai
+OUT=bench/clean/gcv-base
+mkdir -p $OUT
+if [ "$1" != "--eval-only" ]; then
+  $BIN/clean_train --data $DATA --width 64 --window 32 --base-filter butterworth-gcv:2 --base-context 128 \
+    --out $OUT/gcv-base.safetensors --state $OUT/gcv-base.state --plot $OUT/gcv-base.png \
+    --epochs 12 --steps 40 --batch 256 --seed 1 --loss derivative --json $OUT/gcv-base-train.json
+fi
+$BIN/clean_eval --data $DATA --tune-takes 12 --spike-lengths 2,4,8,16,32,64 \
+  --model "gcv base, context 128=$OUT/gcv-base.safetensors" \
+  --json $OUT/eval.json --markdown $OUT/eval.md
