@@ -4,6 +4,7 @@
 # 12 epochs x 40 steps x 256 windows, lr 1e-3, seed 1, default noise) with --base-filter butterworth-gcv:2 and
 # --base-context 128 (noise and filter on the window plus up to 128 frames of its take on each side; in use the
 # filter runs over the whole take). Then the 116-take evaluation with the tuned filters, the shipped model and it.
+# With --guide: a second model that also reads the filter's output (below).
 # Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
 cd "$(dirname "$0")/../.."
@@ -11,6 +12,18 @@ BIN=./target-clean/debug/examples
 DATA=../shared/data/bandai
 OUT=bench/clean/gcv-base
 mkdir -p $OUT
+if [ "$1" == "--guide" ]; then
+  # The same, with the filter's output as 126 more input channels (--base-as-guide): the network sees what the
+  # filter did to its window, which a window of the noisy input does not tell when the filter saw the whole take.
+  $BIN/clean_train --data $DATA --width 64 --window 32 --base-filter butterworth-gcv:2 --base-context 128 --base-as-guide \
+    --out $OUT/gcv-guide.safetensors --state $OUT/gcv-guide.state --plot $OUT/gcv-guide.png \
+    --epochs 12 --steps 40 --batch 256 --seed 1 --loss derivative --json $OUT/gcv-guide-train.json
+  $BIN/clean_eval --data $DATA --tune-takes 12 --spike-lengths 2,4,8,16,32,64 \
+    --model "gcv base, context 128=$OUT/gcv-base.safetensors" \
+    --model "gcv base as guide, context 128=$OUT/gcv-guide.safetensors" \
+    --json $OUT/eval-guide.json --markdown $OUT/eval-guide.md
+  exit 0
+fi
 if [ "$1" != "--eval-only" ]; then
   $BIN/clean_train --data $DATA --width 64 --window 32 --base-filter butterworth-gcv:2 --base-context 128 \
     --out $OUT/gcv-base.safetensors --state $OUT/gcv-base.state --plot $OUT/gcv-base.png \
