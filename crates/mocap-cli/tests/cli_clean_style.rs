@@ -238,6 +238,60 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(output.is_file());
+
+    // On top of the cross-validated filter run over whole takes, reading its
+    // output too; the description says so and `mocap clean` uses it.
+    let based = dir.path().join("based.safetensors");
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "-o",
+        path(&based),
+        "--epochs",
+        "1",
+        "--steps",
+        "2",
+        "--batch",
+        "8",
+        "--width",
+        "8",
+        "--base-filter",
+        "butterworth-gcv:2",
+        "--base-context",
+        "16",
+        "--base-as-guide",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["description"]["base_context"], 16);
+    assert_eq!(
+        report["description"]["network"]["guide_channels"],
+        report["description"]["network"]["channels"]
+    );
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--model",
+        path(&based),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+
+    // The context without a base filter is a usage error.
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "-o",
+        path(&based),
+        "--base-context",
+        "16",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--base-filter"), "{}", stderr(&out));
 }
 
 #[test]
