@@ -101,12 +101,6 @@ impl CleanModel {
         }
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad model description: {e}")))?;
-        if description.network.guide_channels > 0 && description.base_filter.is_none() {
-            return Err(bad(
-                "the network reads a base filter's output but the model names no base filter"
-                    .into(),
-            ));
-        }
         let device = device.device()?;
         let model = description.network.init(&device)?;
         let model = load_weights_from_bytes(bytes, origin, model)?;
@@ -200,10 +194,7 @@ impl CleanModel {
         let mut start_index = 0;
         while start_index < windows {
             let n = batch.min(windows - start_index);
-            // Input rows: the features, then the base's output when it
-            // guides the network (`DenoiserConfig::guide_channels`).
-            let cx = self.description.network.input_channels();
-            let mut x = vec![0.0; n * cx * t];
+            let mut x = vec![0.0; n * c * t];
             let mut offsets = Vec::with_capacity(n);
             // Per window, base(x) - x (see `ModelDescription::base_filter`).
             let mut base_corrections = Vec::new();
@@ -225,19 +216,7 @@ impl CleanModel {
                     (None, None) => None,
                 };
                 offsets.push(recentering);
-                for f in 0..t {
-                    for ch in 0..c {
-                        x[(b * cx + ch) * t + f] = w[f * c + ch];
-                    }
-                }
                 if let Some(filtered) = filtered {
-                    if cx > c {
-                        for f in 0..t {
-                            for ch in 0..c {
-                                x[(b * cx + c + ch) * t + f] = filtered[f * c + ch];
-                            }
-                        }
-                    }
                     base_corrections.push(
                         filtered
                             .iter()
@@ -246,8 +225,13 @@ impl CleanModel {
                             .collect::<Vec<f32>>(),
                     );
                 }
+                for f in 0..t {
+                    for ch in 0..c {
+                        x[(b * c + ch) * t + f] = w[f * c + ch];
+                    }
+                }
             }
-            let input = Tensor::<3>::from_data(TensorData::new(x, [n, cx, t]), &self.device);
+            let input = Tensor::<3>::from_data(TensorData::new(x, [n, c, t]), &self.device);
             let output = self.model.forward(input).into_data();
             let y: Vec<f32> = output
                 .try_to_vec()

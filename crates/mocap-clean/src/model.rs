@@ -49,11 +49,6 @@ pub struct DenoiserConfig {
     /// What the network outputs (default: a denoised copy of its input).
     #[serde(default)]
     pub head: Head,
-    /// Input channels after the `channels` features that guide the network
-    /// but are not corrected by it: the base filter's output of the same
-    /// window when the model sees its base (`channels` of them), else 0.
-    #[serde(default)]
-    pub guide_channels: usize,
 }
 
 /// What the network outputs.
@@ -78,7 +73,6 @@ impl DenoiserConfig {
             kernel: 3,
             window: 16,
             head: Head::Correction,
-            guide_channels: 0,
         }
     }
 
@@ -92,7 +86,6 @@ impl DenoiserConfig {
             kernel: 3,
             window: 16,
             head: Head::Correction,
-            guide_channels: 0,
         }
     }
 
@@ -104,9 +97,6 @@ impl DenoiserConfig {
         }
         if self.kernel.is_multiple_of(2) {
             return bad("the kernel size must be odd");
-        }
-        if self.guide_channels != 0 && self.head != Head::Correction {
-            return bad("only a denoiser takes guide channels");
         }
         if self.head == (Head::SpikeLogits { joints: 0 }) {
             return bad("a spike detector needs at least one joint");
@@ -121,12 +111,7 @@ impl DenoiserConfig {
         self.width << level
     }
 
-    /// Channels of the input: the features and the guides.
-    pub fn input_channels(&self) -> usize {
-        self.channels + self.guide_channels
-    }
-
-    /// Channels of the output: the features, or one per joint.
+    /// Channels of the output: the input's, or one per joint.
     pub fn output_channels(&self) -> usize {
         match self.head {
             Head::Correction => self.channels,
@@ -170,13 +155,12 @@ impl DenoiserConfig {
             });
         }
         Ok(Denoiser {
-            input: conv(self.input_channels(), self.width),
+            input: conv(self.channels, self.width),
             encoder,
             bottleneck: blocks(self.width_at(self.levels)),
             decoder,
             output: conv(self.width, self.output_channels()),
             residual: self.head == Head::Correction,
-            corrected_channels: self.channels,
         })
     }
 
@@ -185,8 +169,8 @@ impl DenoiserConfig {
         let k = self.kernel;
         let conv = |cin: usize, cout: usize, k: usize| cin * cout * k + cout;
         let block = |w: usize| 2 * conv(w, w, k);
-        let mut n = conv(self.input_channels(), self.width, k)
-            + conv(self.width, self.output_channels(), k);
+        let mut n =
+            conv(self.channels, self.width, k) + conv(self.width, self.output_channels(), k);
         for level in 0..self.levels {
             let (w, w2) = (self.width_at(level), self.width_at(level + 1));
             n += 2 * self.blocks * block(w) + conv(w, w2, 4) + (w2 * w * 4 + w);
@@ -233,16 +217,12 @@ pub struct Denoiser {
     /// a spike detector). Not a weight: it comes from the configuration.
     #[module(skip)]
     residual: bool,
-    /// The input channels the global skip adds to the output (the rest
-    /// are guides, see [`DenoiserConfig::guide_channels`]).
-    #[module(skip)]
-    corrected_channels: usize,
 }
 
 impl Denoiser {
-    /// Runs a batch `[batch, channels + guide_channels, frames]` (`frames` a
-    /// multiple of `2^levels`): the cleaned batch `[batch, channels,
-    /// frames]`, or `[batch, joints, frames]` logits for a spike detector.
+    /// Runs a batch `[batch, channels, frames]` (`frames` a multiple of
+    /// `2^levels`): the cleaned batch, or `[batch, joints, frames]` logits
+    /// for a spike detector.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let mut h = relu(self.input.forward(x.clone()));
         let mut skips = Vec::with_capacity(self.encoder.len());
@@ -265,7 +245,7 @@ impl Denoiser {
         }
         let out = self.output.forward(h);
         if self.residual {
-            x.narrow(1, 0, self.corrected_channels) + out
+            x + out
         } else {
             out
         }
@@ -297,33 +277,6 @@ mod tests {
         let x = Tensor::<3>::zeros([3, 12, 16], &device);
         assert_eq!(model.forward(x).dims(), [3, 2, 16]);
         assert_eq!(model.num_params(), config.parameter_count());
-    }
-
-    #[test]
-    fn guides_are_read_but_not_returned() {
-        let device = Device::flex();
-        let config = DenoiserConfig {
-            guide_channels: 12,
-            ..DenoiserConfig::small(12)
-        };
-        let model = config.init(&device).unwrap();
-        let x = Tensor::<3>::zeros([2, 24, 16], &device);
-        assert_eq!(model.forward(x).dims(), [2, 12, 16]);
-        assert_eq!(model.num_params(), config.parameter_count());
-        // The guides reach the output.
-        let guided = Tensor::<3>::cat(
-            vec![
-                Tensor::zeros([1, 12, 16], &device),
-                Tensor::ones([1, 12, 16], &device),
-            ],
-            1,
-        );
-        let moved: f32 = (model.forward(guided)
-            - model.forward(Tensor::zeros([1, 24, 16], &device)))
-        .abs()
-        .max()
-        .into_scalar();
-        assert!(moved > 0.0);
     }
 
     #[test]

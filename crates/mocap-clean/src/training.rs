@@ -103,12 +103,6 @@ pub struct TrainOptions {
     /// See [`ModelDescription::base_context`].
     #[serde(default)]
     pub base_context: usize,
-    /// The network also reads the base filter's output of its window
-    /// ([`crate::model::DenoiserConfig::guide_channels`]): it sees what the
-    /// filter did, which it cannot tell from a window of its input when the
-    /// filter saw the whole take.
-    #[serde(default)]
-    pub base_as_guide: bool,
     /// Network sizes; `channels` is set from the data.
     pub network: DenoiserConfig,
     pub epochs: usize,
@@ -154,7 +148,6 @@ impl Default for TrainOptions {
             frame: RotationFrame::Local,
             base_filter: None,
             base_context: 0,
-            base_as_guide: false,
             network: DenoiserConfig::small(0),
             epochs: 20,
             steps_per_epoch: 40,
@@ -212,9 +205,6 @@ pub struct WindowSampler<'a> {
     /// Frames of the take the noise and the base filter see on each side of
     /// the window ([`ModelDescription::base_context`]).
     context: usize,
-    /// Whether the base's output is an input too (see
-    /// [`WindowSampler::with_base_as_guide`]).
-    guided: bool,
     /// Targets are spike masks (one value per joint and frame) instead of
     /// the clean features.
     spike_targets: bool,
@@ -252,7 +242,6 @@ impl<'a> WindowSampler<'a> {
             noise,
             base: None,
             context: 0,
-            guided: false,
             spike_targets: false,
         })
     }
@@ -273,19 +262,6 @@ impl<'a> WindowSampler<'a> {
     pub fn with_spike_targets(mut self, on: bool) -> Self {
         self.spike_targets = on;
         self
-    }
-
-    /// The network also gets the base filter's output as input channels
-    /// ([`crate::model::DenoiserConfig::guide_channels`]).
-    pub fn with_base_as_guide(mut self, on: bool) -> Self {
-        self.guided = on && self.base.is_some();
-        self
-    }
-
-    /// Rows of an input window: features, and the base's output when it
-    /// guides.
-    fn input_channels(&self) -> usize {
-        self.layout.channels() * if self.guided { 2 } else { 1 }
     }
 
     /// Rows of a target window: features, or joints for spike masks.
@@ -409,26 +385,16 @@ impl<'a> WindowSampler<'a> {
                     for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&filtered) {
                         *y += x - b;
                     }
-                    if self.guided {
-                        // Each frame: the features, then the base's output
-                        // (`DenoiserConfig::guide_channels`).
-                        xf = xf
-                            .chunks(c)
-                            .zip(filtered.chunks(c))
-                            .flat_map(|(x, b)| x.iter().chain(b).copied())
-                            .collect();
-                    }
                 }
                 Ok((xf, yf))
             })
             .collect::<Result<Vec<_>>>()?;
-        let cx = self.input_channels();
-        let mut x = vec![0.0; size * cx * t];
+        let mut x = vec![0.0; size * c * t];
         let mut y = vec![0.0; size * cy * t];
         for (b, (xf, yf)) in samples.iter().enumerate() {
             for f in 0..t {
-                for ch in 0..cx {
-                    x[(b * cx + ch) * t + f] = xf[f * cx + ch];
+                for ch in 0..c {
+                    x[(b * c + ch) * t + f] = xf[f * c + ch];
                 }
                 for ch in 0..cy {
                     y[(b * cy + ch) * t + f] = yf[f * cy + ch];
@@ -526,14 +492,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .collect();
     let mut network = options.network;
     network.channels = layout.channels();
-    if options.base_as_guide {
-        if options.base_filter.is_none() {
-            return Err(CleanError::Invalid(
-                "the base filter's output guides the network only with a base filter".into(),
-            ));
-        }
-        network.guide_channels = network.channels;
-    }
     if options.spike_detector {
         if options.base_filter.is_some() || options.position_weight > 0.0 {
             return Err(CleanError::Invalid(
@@ -600,13 +558,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
         .with_base_filter(options.base_filter, fps, options.base_context)
-        .with_base_as_guide(options.base_as_guide)
         .with_spike_targets(options.spike_detector);
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
         .with_base_filter(options.base_filter, fps, options.base_context)
-        .with_base_as_guide(options.base_as_guide)
         .with_spike_targets(options.spike_detector);
-    let shape = [options.batch_size, network.input_channels(), network.window];
+    let shape = [options.batch_size, network.channels, network.window];
     let target_shape = [
         options.batch_size,
         network.output_channels(),
@@ -633,15 +589,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         valid_batches
             .iter()
             .map(|(x, y)| {
-                // Per sample, the input's first `channels` rows are the
-                // features (the rest guide).
-                let (cx, c, t) = (network.input_channels(), network.channels, network.window);
-                x.chunks(cx * t)
-                    .zip(y.chunks(c * t))
-                    .flat_map(|(x, y)| x[..c * t].iter().zip(y))
+                x.iter()
+                    .zip(y)
                     .map(|(a, b)| ((a - b) * (a - b)) as f64)
                     .sum::<f64>()
-                    / y.len() as f64
+                    / x.len() as f64
             })
             .sum::<f64>()
             / valid_batches.len() as f64
@@ -826,7 +778,6 @@ mod tests {
                 kernel: 3,
                 window: 8,
                 head: Head::Correction,
-                guide_channels: 0,
             },
             epochs: 2,
             steps_per_epoch: 2,
@@ -1010,22 +961,6 @@ mod tests {
         assert!(gap_to_the_filtered_take(40) < 1e-5);
         // Filtering the window alone differs at its borders.
         assert!(gap_to_the_filtered_take(0) > 1e-3);
-
-        // As a guide, the base's output follows the features as input rows:
-        // the same features, and the base the targets were moved by.
-        let guided = WindowSampler::new(&takes, &layout, t, no_noise)
-            .unwrap()
-            .with_base_filter(Some(filter), 30.0, 40)
-            .with_base_as_guide(true);
-        let (x, y) = guided.batch(&mut ChaCha8Rng::seed_from_u64(3), 8).unwrap();
-        assert_eq!(x.len(), 2 * y.len());
-        for b in 0..8 {
-            for i in 0..c * t {
-                let (feature, guide) = (x[b * 2 * c * t + i], x[b * 2 * c * t + c * t + i]);
-                let target = y[b * c * t + i];
-                assert!((guide - (2.0 * feature - target)).abs() < 1e-5);
-            }
-        }
     }
 
     #[test]
@@ -1075,22 +1010,6 @@ mod tests {
         // answer: the context is used in cleaning.
         model.description.base_context = 0;
         let per_window = model.clean(&motion, None).unwrap();
-        let guided = train(&TrainOptions {
-            out: dir.path().join("guided.safetensors"),
-            base_as_guide: true,
-            ..options.clone()
-        })
-        .unwrap();
-        let guided = crate::infer::CleanModel::load(&guided.model, Default::default()).unwrap();
-        let network = guided.description.network;
-        assert!(network.guide_channels > 0);
-        assert_eq!(network.guide_channels, network.channels);
-        assert!(guided
-            .clean(&motion, None)
-            .unwrap()
-            .values()
-            .iter()
-            .all(|v| v.is_finite()));
         let most = whole_take
             .values()
             .iter()

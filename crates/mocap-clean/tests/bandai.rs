@@ -129,17 +129,8 @@ fn the_shipped_model_cleans_a_held_out_take() {
     let motion = read_bvh(&test[0]).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let noisy = add_random_noise_sigma(&motion, 8.0, &RandomNoise::default(), &mut rng);
-    let donor = read_bvh(&test[1]).unwrap();
-    let long_enough: Vec<f32> = (0..motion.frame_count())
-        .flat_map(|f| donor.frame(f % donor.frame_count()).to_vec())
-        .collect();
-    let donor = Motion::new(
-        donor.skeleton().clone(),
-        donor.frame_time(),
-        motion.frame_count(),
-        long_enough,
-    )
-    .unwrap();
+    let donor =
+        mocap_clean::dataset::looped_window(&read_bvh(&test[1]).unwrap(), 0, motion.frame_count());
     let (noisy, _) = add_spike_noise(
         &noisy,
         &[&donor],

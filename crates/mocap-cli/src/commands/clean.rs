@@ -126,10 +126,6 @@ struct TrainArgs {
     /// needs a long stretch to be chosen well). 0: each window alone.
     #[arg(long, value_name = "FRAMES", requires = "base_filter")]
     base_context: Option<usize>,
-    /// With --base-filter: the network also reads the filter's output of its window (what the
-    /// filter did, which a window of the input does not tell when the filter saw the whole take).
-    #[arg(long, requires = "base_filter")]
-    base_as_guide: bool,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -328,7 +324,6 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.frame, a.rotations);
     o.base_filter = a.base_filter;
     set(&mut o.base_context, a.base_context);
-    o.base_as_guide = a.base_as_guide;
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
     set(&mut o.network.levels, a.levels);
