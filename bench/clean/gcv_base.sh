@@ -4,7 +4,7 @@
 # 12 epochs x 40 steps x 256 windows, lr 1e-3, seed 1, default noise) with --base-filter butterworth-gcv:2 and
 # --base-context 128 (noise and filter on the window plus up to 128 frames of its take on each side; in use the
 # filter runs over the whole take). Then the 116-take evaluation with the tuned filters, the shipped model and it.
-# With --finetune: four more epochs at lr 1e-4 (below). The variant that also fed the filter's output to the network
+# With --finetune: four more epochs at lr 1e-4 (below); with --despike: the shipped and the previous model with spike finding. The variant that also fed the filter's output to the network
 # (--base-as-guide, `bench/clean/gcv_base.sh --guide` at commit 7ee92bb) measured the same and was removed.
 # Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
@@ -23,6 +23,15 @@ if [ "$1" == "--finetune" ]; then
     --model "gcv base, context 128=$OUT/gcv-base.safetensors" \
     --model "gcv base, context 128, +4 epochs at lr 1e-4=$OUT/gcv-base-ft.safetensors" \
     --json $OUT/eval-ft.json --markdown $OUT/eval-ft.md
+  exit 0
+fi
+if [ "$1" == "--despike" ]; then
+  # The shipped model (this one, since session 6) and the one shipped before it, each also followed by spike finding.
+  PREVIOUS=$OUT/previous-default.safetensors
+  if [ ! -f $PREVIOUS ]; then git show 1ac5da5:models/clean-default.safetensors > $PREVIOUS; fi
+  $BIN/clean_eval --data $DATA --tune-takes 12 --despike --spike-lengths 2,4,8,16,32,64 \
+    --model "previous shipped model (network on the per-window 2 Hz Butterworth)=$PREVIOUS" \
+    --json $OUT/eval-despike.json --markdown $OUT/eval-despike.md
   exit 0
 fi
 if [ "$1" != "--eval-only" ]; then

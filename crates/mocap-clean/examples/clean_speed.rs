@@ -8,7 +8,7 @@
 //! (feature conversion, windows, network, blending and writing the rotations
 //! back all included; file reading excluded).
 //! Training: samples per second of `train_steps` optimiser steps of the
-//! model's configuration (noise generation included).
+//! model's configuration (noise generation and its base filter included).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -91,6 +91,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             out: dir.join("speed.safetensors"),
             network: model.description.network,
             representation: model.description.representation,
+            frame: model.description.frame,
+            base_filter: model.description.base_filter,
+            base_context: model.description.base_context,
             epochs: 1,
             steps_per_epoch: train_steps,
             batch_size: batch,
