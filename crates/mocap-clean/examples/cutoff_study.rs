@@ -5,7 +5,9 @@
 //! of a grid, of the best single cutoff per take (oracle), and of the cutoff
 //! chosen by generalised cross-validation (GCV) per take, per joint, and per
 //! channel (`butterworth-gcv:2`, on the whole take and on separate 32-frame
-//! windows).
+//! windows), and the best cutoff of the grid per joint and per channel
+//! chosen with the clean take in hand (oracles: how far choosing the cutoff
+//! better could take a Butterworth at all).
 //!
 //! cargo run --profile test -p mocap-clean --example cutoff_study -- DATA [TAKES] [SIGMAS]
 
@@ -48,7 +50,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for c in CUTOFFS {
         print!(" {c} Hz |");
     }
-    println!(" oracle per take | GCV per take | GCV per joint | butterworth-gcv:2 (GCV per channel) | the same on 32-frame windows |");
+    println!(" oracle per take | GCV per take | GCV per joint | butterworth-gcv:2 (GCV per channel) | the same on 32-frame windows | oracle per joint | oracle per channel |");
     for &sigma in &sigmas {
         let rows: Vec<Vec<f64>> = takes
             .par_iter()
@@ -93,27 +95,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                     gcv_score(rss, gcv_trace_fraction(2, CUTOFFS[k], fps, frames))
                 };
-                let pick = |ch: std::ops::Range<usize>| {
-                    (0..CUTOFFS.len())
-                        .map(|k| (k, score(k, ch.clone())))
-                        .min_by(|a, b| a.1.total_cmp(&b.1))
-                        .map(|(k, _)| k)
-                        .unwrap()
-                };
-                let whole = pick(0..channels);
-                row.push(row[1 + whole]);
-                let mut mixed = x.clone();
-                for k in 0..layout.joints.len() {
-                    let best = pick(k * dim..(k + 1) * dim);
+                // The oracle's score: the squared error against the clean
+                // features.
+                let target = layout.encode(clean);
+                let clean_error = |k: usize, ch: std::ops::Range<usize>| {
+                    let y = &filtered[k];
+                    let mut sum = 0.0f64;
                     for f in 0..frames {
-                        for c in k * dim..(k + 1) * dim {
-                            mixed[f * channels + c] = filtered[best][f * channels + c];
+                        for c in ch.clone() {
+                            let d = (target[f * channels + c] - y[f * channels + c]) as f64;
+                            sum += d * d;
                         }
                     }
-                }
+                    sum
+                };
+                let pick_by =
+                    |ch: std::ops::Range<usize>,
+                     by: &dyn Fn(usize, std::ops::Range<usize>) -> f64| {
+                        (0..CUTOFFS.len())
+                            .map(|k| (k, by(k, ch.clone())))
+                            .min_by(|a, b| a.1.total_cmp(&b.1))
+                            .map(|(k, _)| k)
+                            .unwrap()
+                    };
+                let pick = |ch: std::ops::Range<usize>| pick_by(ch, &score);
+                let whole = pick(0..channels);
+                row.push(row[1 + whole]);
+                // Each group of channels (`width` wide) filtered at the
+                // cutoff its chooser picks; the rotation error of the result.
                 let mut out = noisy.clone();
-                layout.decode_into(&mixed, &mut out);
-                row.push(rotation_error_deg(clean, &out));
+                let mut mixed_error =
+                    |width: usize, by: &dyn Fn(usize, std::ops::Range<usize>) -> f64| {
+                        let mut mixed = x.clone();
+                        for g in 0..channels / width {
+                            let group = g * width..(g + 1) * width;
+                            let best = pick_by(group.clone(), by);
+                            for f in 0..frames {
+                                for c in group.clone() {
+                                    mixed[f * channels + c] = filtered[best][f * channels + c];
+                                }
+                            }
+                        }
+                        layout.decode_into(&mixed, &mut out);
+                        rotation_error_deg(clean, &out)
+                    };
+                row.push(mixed_error(dim, &score));
+                let oracles = [mixed_error(dim, &clean_error), mixed_error(1, &clean_error)];
                 // The filter itself, on the whole take and on separate
                 // 32-frame windows (as a model's base filter runs).
                 let gcv_filter = Filter::ButterworthGcv { order: 2 };
@@ -127,6 +154,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 layout.decode_into(&y, &mut out);
                 row.push(rotation_error_deg(clean, &out));
+                row.extend(oracles);
                 row
             })
             .collect();
