@@ -828,20 +828,36 @@ mod tests {
         assert!(b.plot.is_file());
     }
 
-    #[test]
-    fn a_base_filter_moves_the_target_by_what_the_filter_changes() {
-        let takes: Vec<Take> = (0..3)
+    /// Three synthetic 40-frame takes of 4 joints.
+    fn three_takes() -> Vec<Take> {
+        (0..3)
             .map(|i| Take {
                 name: format!("take_{i}"),
                 path: PathBuf::new(),
                 motion: synthetic_motion_phase(40, 4, i as f32),
             })
-            .collect();
+            .collect()
+    }
+
+    const TWO_HERTZ: Filter = Filter::Butterworth {
+        order: 2,
+        cutoff_hz: 2.0,
+    };
+
+    /// Sample `b` of a `[sample, channel, frame]` batch, frame after frame
+    /// (as features and filters take it).
+    fn frame_major(batch: &[f32], b: usize, c: usize, t: usize) -> Vec<f32> {
+        (0..t)
+            .flat_map(|f| (0..c).map(move |ch| (f, ch)))
+            .map(|(f, ch)| batch[(b * c + ch) * t + f])
+            .collect()
+    }
+
+    #[test]
+    fn a_base_filter_moves_the_target_by_what_the_filter_changes() {
+        let takes = three_takes();
         let layout = FeatureLayout::new(takes[0].motion.skeleton(), Representation::Rot6d).unwrap();
-        let filter = Filter::Butterworth {
-            order: 2,
-            cutoff_hz: 2.0,
-        };
+        let filter = TWO_HERTZ;
         let plain = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default()).unwrap();
         let based = WindowSampler::new(&takes, &layout, 16, NoiseConfig::default())
             .unwrap()
@@ -852,17 +868,10 @@ mod tests {
         let (c, t) = (layout.channels(), 16);
         let mut moved = 0.0f32;
         for b in 0..4 {
-            // The batch is [sample, channel, frame]; filters take frames.
-            let frame_major = |v: &[f32]| -> Vec<f32> {
-                (0..t)
-                    .flat_map(|f| (0..c).map(move |ch| (f, ch)))
-                    .map(|(f, ch)| v[(b * c + ch) * t + f])
-                    .collect()
-            };
-            let x = frame_major(&x1);
+            let x = frame_major(&x1, b, c, t);
             let mut filtered = x.clone();
             filter_features(&mut filtered, c, &filter, 30.0);
-            let (plain_y, based_y) = (frame_major(&y1), frame_major(&y2));
+            let (plain_y, based_y) = (frame_major(&y1, b, c, t), frame_major(&y2, b, c, t));
             for i in 0..x.len() {
                 let expected = plain_y[i] + x[i] - filtered[i];
                 assert!((based_y[i] - expected).abs() < 1e-5);
@@ -897,18 +906,9 @@ mod tests {
     /// as in use on the whole take; without one on the window alone.
     #[test]
     fn a_base_context_filters_the_take_around_the_window() {
-        let takes: Vec<Take> = (0..3)
-            .map(|i| Take {
-                name: format!("take_{i}"),
-                path: PathBuf::new(),
-                motion: synthetic_motion_phase(40, 4, i as f32),
-            })
-            .collect();
+        let takes = three_takes();
         let layout = FeatureLayout::new(takes[0].motion.skeleton(), Representation::Rot6d).unwrap();
-        let filter = Filter::Butterworth {
-            order: 2,
-            cutoff_hz: 2.0,
-        };
+        let filter = TWO_HERTZ;
         // No noise: the input window is a window of a take, and the target
         // is y + x - base = 2x - base.
         let no_noise = NoiseConfig {
@@ -934,13 +934,7 @@ mod tests {
             let (x, y) = sampler.batch(&mut ChaCha8Rng::seed_from_u64(3), 8).unwrap();
             let mut gap = 0.0f32;
             for b in 0..8 {
-                let frame_major = |v: &[f32]| -> Vec<f32> {
-                    (0..t)
-                        .flat_map(|f| (0..c).map(move |ch| (f, ch)))
-                        .map(|(f, ch)| v[(b * c + ch) * t + f])
-                        .collect()
-                };
-                let (xw, yw) = (frame_major(&x), frame_major(&y));
+                let (xw, yw) = (frame_major(&x, b, c, t), frame_major(&y, b, c, t));
                 let (take, start) = (0..takes.len())
                     .flat_map(|k| (0..=40 - t).map(move |s| (k, s)))
                     .find(|&(k, s)| {

@@ -203,23 +203,15 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     for file in files.iter().step_by(files.len() / 40).take(40) {
         std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
     }
+    // A tiny network, a few steps, the report on stdout; `extra` adds options.
+    let train = |model: &Path, extra: &[&str]| {
+        let mut args = vec!["clean", "train", path(&takes), "-o", path(model)];
+        args.extend(["--steps", "2", "--batch", "8", "--width", "8", "--json"]);
+        args.extend(extra);
+        mocap(&args)
+    };
     let model = dir.path().join("tiny.safetensors");
-    let out = mocap(&[
-        "clean",
-        "train",
-        path(&takes),
-        "-o",
-        path(&model),
-        "--epochs",
-        "2",
-        "--steps",
-        "2",
-        "--batch",
-        "8",
-        "--width",
-        "8",
-        "--json",
-    ]);
+    let out = train(&model, &["--epochs", "2"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["history"]["epochs"].as_array().unwrap().len(), 2);
@@ -242,26 +234,17 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     // On top of the cross-validated filter run over whole takes; the
     // description says so and `mocap clean` uses it.
     let based = dir.path().join("based.safetensors");
-    let out = mocap(&[
-        "clean",
-        "train",
-        path(&takes),
-        "-o",
-        path(&based),
-        "--epochs",
-        "1",
-        "--steps",
-        "2",
-        "--batch",
-        "8",
-        "--width",
-        "8",
-        "--base-filter",
-        "butterworth-gcv:2",
-        "--base-context",
-        "16",
-        "--json",
-    ]);
+    let out = train(
+        &based,
+        &[
+            "--epochs",
+            "1",
+            "--base-filter",
+            "butterworth-gcv:2",
+            "--base-context",
+            "16",
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["description"]["base_context"], 16);
@@ -276,15 +259,7 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     assert!(out.status.success(), "{}", stderr(&out));
 
     // The context without a base filter is a usage error.
-    let out = mocap(&[
-        "clean",
-        "train",
-        path(&takes),
-        "-o",
-        path(&based),
-        "--base-context",
-        "16",
-    ]);
+    let out = train(&based, &["--base-context", "16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("--base-filter"), "{}", stderr(&out));
 }
