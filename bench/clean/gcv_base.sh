@@ -4,7 +4,7 @@
 # 12 epochs x 40 steps x 256 windows, lr 1e-3, seed 1, default noise) with --base-filter butterworth-gcv:2 and
 # --base-context 128 (noise and filter on the window plus up to 128 frames of its take on each side; in use the
 # filter runs over the whole take). Then the 116-take evaluation with the tuned filters, the shipped model and it.
-# With --finetune: four more epochs at lr 1e-4 (below); with --despike: the shipped and the previous model with spike finding. The variant that also fed the filter's output to the network
+# With --window64: 64-frame windows; with --finetune: four more epochs at lr 1e-4 (below); with --despike: the shipped and the previous model with spike finding. The variant that also fed the filter's output to the network
 # (--base-as-guide, `bench/clean/gcv_base.sh --guide` at commit 7ee92bb) measured the same and was removed.
 # Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
@@ -13,6 +13,16 @@ BIN=./target-clean/debug/examples
 DATA=../shared/data/bandai
 OUT=bench/clean/gcv-base
 mkdir -p $OUT
+if [ "$1" == "--window64" ]; then
+  # The same with 64-frame windows and 128 per batch (the same frames per step).
+  $BIN/clean_train --data $DATA --width 64 --window 64 --base-filter butterworth-gcv:2 --base-context 128 \
+    --out $OUT/gcv-base-w64.safetensors --state $OUT/gcv-base-w64.state --plot $OUT/gcv-base-w64.png \
+    --epochs 12 --steps 40 --batch 128 --seed 1 --loss derivative --json $OUT/gcv-base-w64-train.json
+  $BIN/clean_eval --data $DATA --tune-takes 12 --spike-lengths 2,4,8,16,32,64 \
+    --model "gcv base, context 128, window 64=$OUT/gcv-base-w64.safetensors" \
+    --json $OUT/eval-w64.json --markdown $OUT/eval-w64.md
+  exit 0
+fi
 if [ "$1" == "--finetune" ]; then
   # Four more epochs of the trained model at lr 1e-4 (its validation MSE was flat at lr 1e-3 from epoch 6).
   if [ ! -d $OUT/gcv-base-ft.state ]; then cp -r $OUT/gcv-base.state $OUT/gcv-base-ft.state; fi
