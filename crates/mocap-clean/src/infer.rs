@@ -29,7 +29,7 @@ use crate::features::FeatureLayout;
 use crate::filters::{filter_features, filter_motion, Filter};
 use crate::model::{Denoiser, Head};
 use crate::spikes::{SpikeDetector, SpikeOptions};
-use crate::training::{ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
+use crate::training::{window_base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
 use crate::{CleanError, Result};
 
 /// Where the shipped default model lives in the source tree.
@@ -202,19 +202,12 @@ impl CleanModel {
                 let s = (start_index + b) * hop;
                 let mut w = padded[s * c..(s + t) * c].to_vec();
                 let recentering = layout.recenter(&mut w);
-                let filtered = match (&padded_filtered, &self.description.base_filter) {
-                    (Some(take), _) => {
-                        let mut filtered = take[s * c..(s + t) * c].to_vec();
-                        recentering.apply(&mut filtered);
-                        Some(filtered)
-                    }
-                    (None, Some(filter)) => {
-                        let mut filtered = w.clone();
-                        filter_features(&mut filtered, c, filter, self.description.fps);
-                        Some(filtered)
-                    }
-                    (None, None) => None,
-                };
+                let filtered = self.description.base_filter.as_ref().map(|filter| {
+                    let around = padded_filtered
+                        .as_deref()
+                        .map(|take| &take[s * c..(s + t) * c]);
+                    window_base(&w, around, &recentering, filter, c, self.description.fps)
+                });
                 offsets.push(recentering);
                 if let Some(filtered) = filtered {
                     base_corrections.push(

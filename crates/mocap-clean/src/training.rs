@@ -34,7 +34,7 @@ use crate::dataset::{
     list_bvh, load_takes, looped_window, paths_in_split, split_of, take_name, window,
     DataDescription, Split, SplitFractions, Take,
 };
-use crate::features::{FeatureLayout, Representation, RotationFrame};
+use crate::features::{FeatureLayout, Recentering, Representation, RotationFrame};
 use crate::filters::{filter_features, Filter};
 use crate::fk::FkSkeleton;
 use crate::loss::{binary_cross_entropy_with_logits, derivative_loss, position_loss, LossWeights};
@@ -366,23 +366,17 @@ impl<'a> WindowSampler<'a> {
                 let recentering = self.layout.recenter(&mut xf);
                 recentering.apply(&mut yf);
                 if let Some((filter, fps)) = &self.base {
-                    // As in use (`CleanModel::clean`): with a context the
-                    // filter runs on the whole stretch before the window is
-                    // cut and recentred, without one on the recentred window.
-                    let filtered = if self.context > 0 {
+                    // With a context the filter sees the whole stretch, as
+                    // it sees the whole take in use.
+                    let around = (self.context > 0).then(|| {
                         let mut filtered = xs.clone();
                         filter_features(&mut filtered, c, filter, *fps);
-                        let mut filtered = crop(&filtered);
-                        recentering.apply(&mut filtered);
-                        filtered
-                    } else {
-                        let mut filtered = xf.clone();
-                        filter_features(&mut filtered, c, filter, *fps);
-                        filtered
-                    };
+                        crop(&filtered)
+                    });
+                    let base = window_base(&xf, around.as_deref(), &recentering, filter, c, *fps);
                     // The network's output N(x) stands for y - base(x) + x,
                     // so that the model's output N(x) - x + base(x) is y.
-                    for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&filtered) {
+                    for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&base) {
                         *y += x - b;
                     }
                 }
@@ -402,6 +396,34 @@ impl<'a> WindowSampler<'a> {
             }
         }
         Ok((x, y))
+    }
+}
+
+/// The base filter's output for the recentred window `window` of
+/// `channels` features, in training and in use alike (see
+/// [`ModelDescription::base_context`]): `filtered_around` is the same frames
+/// cut from the filter's output over a longer stretch (the take around the
+/// window), brought here onto the window's branch; without it the filter
+/// runs on the window itself.
+pub(crate) fn window_base(
+    window: &[f32],
+    filtered_around: Option<&[f32]>,
+    recentering: &Recentering,
+    filter: &Filter,
+    channels: usize,
+    fps: f32,
+) -> Vec<f32> {
+    match filtered_around {
+        Some(around) => {
+            let mut base = around.to_vec();
+            recentering.apply(&mut base);
+            base
+        }
+        None => {
+            let mut base = window.to_vec();
+            filter_features(&mut base, channels, filter, fps);
+            base
+        }
     }
 }
 
@@ -503,6 +525,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         };
     }
     network.validate()?;
+    if options.base_context > 0 && options.base_filter.is_none() {
+        return Err(CleanError::Invalid(
+            "a base context needs a base filter (the context is what that filter sees)".into(),
+        ));
+    }
     let description = ModelDescription {
         network,
         representation: options.representation,
@@ -510,11 +537,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         joints,
         fps,
         base_filter: options.base_filter,
-        base_context: if options.base_filter.is_some() {
-            options.base_context
-        } else {
-            0
-        },
+        base_context: options.base_context,
     };
     let loss = if options.derivative_loss {
         LossWeights::derivative(fps)
@@ -917,10 +940,11 @@ mod tests {
             spike_probability: 0.0,
         };
         let (c, t) = (layout.channels(), 16);
-        let filtered_takes: Vec<Vec<f32>> = takes
+        let encoded: Vec<Vec<f32>> = takes.iter().map(|t| layout.encode(&t.motion)).collect();
+        let filtered_takes: Vec<Vec<f32>> = encoded
             .iter()
-            .map(|take| {
-                let mut f = layout.encode(&take.motion);
+            .map(|features| {
+                let mut f = features.clone();
                 filter_features(&mut f, c, &filter, 30.0);
                 f
             })
@@ -938,8 +962,7 @@ mod tests {
                 let (take, start) = (0..takes.len())
                     .flat_map(|k| (0..=40 - t).map(move |s| (k, s)))
                     .find(|&(k, s)| {
-                        let features = layout.encode(&takes[k].motion);
-                        features[s * c..(s + t) * c]
+                        encoded[k][s * c..(s + t) * c]
                             .iter()
                             .zip(&xw)
                             .all(|(a, b)| (a - b).abs() < 1e-6)
@@ -1011,6 +1034,14 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0f32, f32::max);
         assert!(most > 1e-3, "{most}");
+        // A context without a base filter is an error, not silently dropped.
+        let error = train(&TrainOptions {
+            base_filter: None,
+            ..options
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains("base filter"), "{error}");
     }
 
     #[test]
