@@ -39,9 +39,10 @@ use crate::dataset::{
 };
 use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
-use crate::infer::CleanModel;
+use crate::infer::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
 use crate::spikes::{SpikeDetector, SpikeOptions};
+use crate::wiener::WienerFilter;
 use crate::{CleanError, Result};
 
 /// Mean geodesic angle (degrees) between the local rotations of two
@@ -308,6 +309,7 @@ fn tune_despike(
 enum Cleaner {
     Filter(Filter),
     Model(Rc<CleanModel>),
+    Wiener(Rc<WienerFilter>),
     Spikes(Rc<SpikeDetector>),
     /// The first, then the second on its output.
     Then(Box<Cleaner>, Box<Cleaner>),
@@ -318,6 +320,7 @@ impl Cleaner {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
             Cleaner::Model(m) => m.clean(noisy, None),
+            Cleaner::Wiener(w) => Ok(w.clean(noisy, None)?.0),
             Cleaner::Spikes(d) => Ok(d.remove_spikes(noisy, &SpikeOptions::default())?.0),
             Cleaner::Then(first, second) => second.run(&first.run(noisy)?),
         }
@@ -444,11 +447,14 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     let takes = load_takes(&eval_paths)?;
     let mut models = Vec::new();
     for m in &options.models {
-        let model = match &m.path {
-            Some(p) => CleanModel::load(p, options.device)?,
-            None => CleanModel::load_default(options.device)?,
+        let cleaner = match &m.path {
+            Some(p) => match ModelFile::load(p, options.device)? {
+                ModelFile::Network(model) => Cleaner::Model(Rc::from(model)),
+                ModelFile::Wiener(filter) => Cleaner::Wiener(Rc::new(filter)),
+            },
+            None => Cleaner::Model(Rc::new(CleanModel::load_default(options.device)?)),
         };
-        models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
+        models.push((m.label.clone(), cleaner));
     }
     let detector = match &options.spike_detector {
         Some(entry) => Some((

@@ -20,6 +20,8 @@
 //!   denoiser;
 //! - [`filters`]: classical baselines (zero-phase Butterworth,
 //!   Savitzky-Golay, median, One Euro);
+//! - [`wiener`]: a learned multichannel Wiener filter (the spectra of clean
+//!   motion and the noise covariance, fitted to training takes);
 //! - [`dataset`]: BVH takes split by take, windows;
 //! - [`model`]: the autoencoder and its configuration;
 //! - [`loss`]: the derivative loss and the optional position term;
@@ -44,6 +46,7 @@ pub mod model;
 pub mod noise;
 pub mod spikes;
 pub mod training;
+pub mod wiener;
 
 #[cfg(test)]
 pub(crate) mod test_support;

@@ -265,6 +265,95 @@ fn clean_train_writes_a_model_that_clean_can_use() {
 }
 
 #[test]
+fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
+    let Some(data) = mocap_testdata::shared_data() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let takes = dir.path().join("takes");
+    std::fs::create_dir(&takes).unwrap();
+    let files: Vec<PathBuf> = mocap_testdata::bvh_files(&data.join("bandai/dataset-2"));
+    for file in files.iter().step_by(files.len() / 40).take(40) {
+        std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
+    }
+    let filter = dir.path().join("wiener.safetensors");
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "--wiener",
+        "-o",
+        path(&filter),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        report["description"]["takes"].as_u64().unwrap() >= 20,
+        "{report}"
+    );
+    assert_eq!(report["description"]["segment"], 32);
+    assert!(filter.is_file());
+
+    // `mocap clean --model` tells the filter from a network by its header.
+    let output = dir.path().join("clean.bvh");
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let out = mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--model",
+        path(&filter),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        report["method"]
+            .as_str()
+            .unwrap()
+            .starts_with("Wiener filter"),
+        "{report}"
+    );
+    assert!(output.is_file());
+
+    // So does the evaluation.
+    let label = format!("learned Wiener={}", path(&filter));
+    let out = mocap(&[
+        "clean",
+        "eval",
+        path(&takes),
+        "--all-takes",
+        "--max-takes",
+        "2",
+        "--no-default-model",
+        "--no-filters",
+        "--spike-lengths",
+        "none",
+        "--model",
+        &label,
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("learned Wiener"), "{text}");
+
+    // Network options do not go with --wiener.
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "--wiener",
+        "--epochs",
+        "3",
+        "-o",
+        path(&filter),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+}
+
+#[test]
 fn style_apply_restyles_the_bundled_walk() {
     let dir = tempfile::tempdir().unwrap();
     let source = sample("dataset-1_walk_normal_001.bvh");

@@ -16,6 +16,7 @@ use mocap_clean::infer::{clean_file, CleanOptions, FindSpikes, Method};
 use mocap_clean::model::DenoiserConfig;
 use mocap_clean::spikes::SpikeOptions;
 use mocap_clean::training::{train, TrainOptions};
+use mocap_clean::wiener::{fit_files, WienerFitOptions};
 use mocap_nn::device::DeviceChoice;
 
 use super::{write_output, GlobalOptions};
@@ -46,7 +47,8 @@ struct TakeArgs {
     /// The cleaned take (BVH: same skeleton and channel layout, root translation kept).
     #[arg(long, short, required = true)]
     output: Option<PathBuf>,
-    /// A model file written by `mocap clean train` (default: the model shipped with mocap).
+    /// A file written by `mocap clean train`: a network, or a Wiener filter (`--wiener`)
+    /// (default: the model shipped with mocap).
     #[arg(long, conflicts_with = "filter")]
     model: Option<PathBuf>,
     /// A classical filter instead of a model: butterworth:ORDER:HZ,
@@ -173,6 +175,19 @@ struct TrainArgs {
     /// the same network with one output per joint and frame, trained to mark the synthetic spikes.
     #[arg(long, conflicts_with_all = ["base_filter", "position_weight"])]
     spike_detector: bool,
+    /// Fit a learned multichannel Wiener filter instead of training a network (a minute, not
+    /// twenty: the spectra of the clean training takes and the covariance of the random noise;
+    /// `mocap clean --model` and `mocap clean eval --model` take the file; see
+    /// bench/results/clean.md).
+    #[arg(long, conflicts_with_all = [
+        "spike_detector", "base_filter", "resume", "large", "epochs", "steps", "batch", "lr",
+        "representation", "rotations", "position_weight", "width", "levels", "blocks", "window",
+        "max_sigma", "spike_probability", "max_spikes", "spike_sigma", "plot", "state",
+    ])]
+    wiener: bool,
+    /// With --wiener: frames per Fourier segment (default 32).
+    #[arg(long, value_name = "FRAMES", requires = "wiener")]
+    segment: Option<usize>,
     /// Training and validation curves as PNG (default: OUTPUT with extension png).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -300,6 +315,9 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
 }
 
 fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    if a.wiener {
+        return run_fit_wiener(a, options);
+    }
     let mut o = TrainOptions {
         inputs: a.inputs,
         out: a.output,
@@ -350,6 +368,44 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             last.map_or(f64::NAN, |e| e.valid_loss),
             report.model.display(),
             report.plot.display()
+        );
+    }
+    Ok(())
+}
+
+fn run_fit_wiener(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    let mut o = WienerFitOptions {
+        inputs: a.inputs,
+        out: a.output,
+        max_train_takes: a.max_train_takes,
+        ..WienerFitOptions::default()
+    };
+    set(&mut o.segment, a.segment);
+    set(&mut o.seed, a.seed);
+    o.noise.perturb_above_pelvis |= a.noise_above_pelvis;
+    if !options.quiet && !a.json {
+        eprintln!(
+            "fitting a Wiener filter to the training takes (about a minute for the Bandai data)"
+        );
+    }
+    let report = fit_files(&o)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else if !options.quiet {
+        let d = &report.description;
+        eprintln!(
+            "fitted to {} takes ({} frames, {} segments of {} frames{}) in {:.1} s; wrote {}",
+            d.takes,
+            d.frames,
+            d.segments,
+            d.segment,
+            if d.other_rig_takes > 0 {
+                format!("; {} takes on other rigs left out", d.other_rig_takes)
+            } else {
+                String::new()
+            },
+            report.seconds,
+            report.model.display()
         );
     }
     Ok(())

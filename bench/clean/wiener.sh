@@ -1,0 +1,22 @@
+#!/bin/bash
+# The learned multichannel Wiener filter (bench/results/clean.md, "A learned multichannel Wiener filter"):
+# fitted to the training takes by `mocap clean train --wiener` (models/clean-wiener.safetensors, segment 32,
+# noise covariance at 5 degrees, seed 1), then the 116-take evaluation with the tuned filters, the shipped
+# network and it; and the study on 40 validation takes at fixed noise levels (wiener_bound example).
+# Binaries: cargo build -p mocap-cli; CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
+set -e
+cd "$(dirname "$0")/../.."
+BIN=./target-clean/debug/examples
+DATA=../shared/data/bandai
+OUT=bench/clean/wiener
+mkdir -p $OUT
+if [ "$1" != "--eval-only" ]; then
+  ./target/debug/mocap clean train $DATA --wiener -o models/clean-wiener.safetensors --json > $OUT/fit.json
+fi
+$BIN/clean_eval --data $DATA --tune-takes 12 --spike-lengths 2,4,8,16,32,64 \
+  --model "Wiener filter (learned, multichannel)=models/clean-wiener.safetensors" \
+  --json $OUT/eval.json --markdown $OUT/eval.md
+$BIN/wiener_bound $DATA 40 > $OUT/study.md
+for segment in 16 24 64 128; do  # 32 is the study above
+  $BIN/wiener_bound $DATA 40 2,6,10 $segment > $OUT/study-segment-$segment.md
+done

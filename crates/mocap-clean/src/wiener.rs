@@ -1,0 +1,924 @@
+//! A learned multichannel Wiener filter: the best *linear* time-invariant
+//! estimate of clean motion from a take with the random noise of
+//! [`crate::noise`], given the spectra of clean motion.
+//!
+//! ## Method
+//!
+//! The features are the 6D rotations of every joint of a rig
+//! ([`crate::features`]), `c` channels per frame, minus their mean over the
+//! take. Per frequency `f`:
+//!
+//! - the clean motion has a cross-spectral matrix `S(f)` (`c x c`, all
+//!   channels together), estimated by Welch's method (Hann windows of
+//!   [`WienerDescription::segment`] frames, half overlapping) on training
+//!   takes;
+//! - the random noise is white in time with a per-frame covariance
+//!   `s N`, `s = (sigma / sigma_ref)^2`: `N` is measured by noising training
+//!   takes at `sigma_ref`. It is far from diagonal: the chain correction
+//!   makes a joint's error reappear, turned, in its children's local
+//!   rotations.
+//!
+//! The estimate is Wiener's (1949), per frequency:
+//!
+//! ```text
+//! Y(f) = S(f) (S(f) + s N)^-1 X(f)                                   (1)
+//! ```
+//!
+//! It uses what a per-channel low-pass cannot: which *combinations* of
+//! channels carry motion and which carry mostly noise at each frequency.
+//! With `N^-1/2 S(f) N^-1/2 = V diag(lambda) V^H` (both whitened by the
+//! noise), (1) is `N^1/2 V diag(lambda / (lambda + s)) V^H N^-1/2 X(f)`, so
+//! a new noise level costs no matrix inversion. It runs as a short-time
+//! Fourier transform: square-root Hann windows half a segment apart (their
+//! squares sum to one), the take padded by reflection.
+//!
+//! ## Noise level
+//!
+//! `sigma` is chosen per take by maximum marginal likelihood: under the
+//! model each whitened coefficient `z = V^H N^-1/2 X(f)` is a complex
+//! Gaussian of variance `lambda + s`, so
+//!
+//! ```text
+//! log L(s) = sum over segments, frequencies, coordinates of
+//!            -log(lambda + s) - |z|^2 / (lambda + s)                  (2)
+//! ```
+//!
+//! (half weight at the real frequencies 0 and Nyquist), maximised over a
+//! grid of `sigma`. A clean take gets a `sigma` near 0 and is nearly left
+//! alone.
+//!
+//! ## Limits
+//!
+//! It is linear: spikes (another motion pasted on a subtree) are smeared,
+//! not removed. It is fitted to one rig (the joints with rotation channels,
+//! by name and order) and one frame rate, like a network.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use burn::module::{Module, Param};
+use burn::tensor::{Device, Tensor, TensorData};
+use mocap_core::Motion;
+use mocap_nn::checkpoint::{
+    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
+};
+use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
+use rand::rngs::ChaCha8Rng;
+use rand::SeedableRng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::{
+    list_bvh, load_takes, paths_in_split, split_of, take_name, DataDescription, Split,
+    SplitFractions,
+};
+use crate::features::{FeatureLayout, Representation};
+use crate::noise::{add_random_noise_sigma, RandomNoise};
+use crate::{CleanError, Result};
+
+type C64 = Complex<f64>;
+/// One segment's coefficients, one vector per frequency bin.
+type SegmentCoefficients = Vec<DVector<C64>>;
+
+/// Kind of a Wiener filter file (the checkpoint header's `kind`).
+pub const WIENER_KIND: &str = "mocap-clean/wiener";
+/// Version of [`WienerDescription`]'s layout.
+pub const WIENER_KIND_VERSION: u32 = 1;
+
+/// The noise levels (degrees) the marginal likelihood (2) is evaluated at.
+fn sigma_grid_deg() -> impl Iterator<Item = f64> {
+    (0..=300).map(|i| 0.05 + 0.1 * i as f64)
+}
+
+/// What a Wiener filter was fitted to, stored in its file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WienerDescription {
+    /// The joints with rotation channels, in feature order.
+    pub joints: Vec<String>,
+    /// Features per frame (6 per joint).
+    pub channels: usize,
+    pub fps: f32,
+    /// Frames per Fourier segment (even).
+    pub segment: usize,
+    /// The noise model `N` was measured with, and at which level.
+    pub noise: RandomNoise,
+    pub noise_sigma_deg: f32,
+    /// Training takes, frames and Welch segments the spectra come from.
+    pub takes: usize,
+    pub frames: usize,
+    pub segments: usize,
+    /// Takes left out because their rig differs from the first take's.
+    pub other_rig_takes: usize,
+}
+
+/// The stored numbers: per frequency bin the real and imaginary parts of
+/// `S(f)` (`[bins, c, c]`), and `N` (`[c, c]`). A burn module only so that
+/// it is written and read by the checkpoint code the networks use.
+#[derive(Module, Debug)]
+struct WienerTensors {
+    spectra_re: Param<Tensor<3>>,
+    spectra_im: Param<Tensor<3>>,
+    noise: Param<Tensor<2>>,
+}
+
+/// One frequency bin of (1), in the noise-whitened eigenbasis.
+#[derive(Debug, Clone)]
+struct Bin {
+    /// `V^H N^-1/2`.
+    to_white: DMatrix<C64>,
+    /// `N^1/2 V`.
+    from_white: DMatrix<C64>,
+    /// Eigenvalues of the whitened signal spectrum (>= 0).
+    lambda: Vec<f64>,
+    /// The same decomposition restricted to the directions the noise model
+    /// puts noise in (no ridge), for judging the noise level (2):
+    /// `V'^H D^-1/2 Q^T` with `N = Q D Q^T` over those directions.
+    judge: DMatrix<C64>,
+    judge_lambda: Vec<f64>,
+}
+
+/// A fitted filter (see the module docs).
+#[derive(Debug, Clone)]
+pub struct WienerFilter {
+    pub description: WienerDescription,
+    spectra: Vec<DMatrix<C64>>,
+    noise: DMatrix<f64>,
+    bins: Vec<Bin>,
+}
+
+/// What filtering a take did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WienerOutcome {
+    /// The noise level used (estimated unless given), degrees.
+    pub sigma_deg: f64,
+}
+
+/// Periodic Hann window of `len` frames at `t`.
+fn hann(t: usize, len: usize) -> f64 {
+    0.5 - 0.5 * (2.0 * PI * t as f64 / len as f64).cos()
+}
+
+/// `x` (frames x c) minus its per-channel mean, as f64, and the mean.
+fn centred(x: &[f32], c: usize) -> (Vec<f64>, Vec<f64>) {
+    let frames = x.len() / c;
+    let mut mean = vec![0.0; c];
+    for frame in x.chunks_exact(c) {
+        for (m, &v) in mean.iter_mut().zip(frame) {
+            *m += v as f64 / frames as f64;
+        }
+    }
+    let y = x
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| v as f64 - mean[i % c])
+        .collect();
+    (y, mean)
+}
+
+/// `x` (frames x c) padded with `pad` frames on each side, mirrored about
+/// the end frames (bouncing again where the take is shorter than `pad`).
+fn reflect_pad(x: &[f64], c: usize, pad: usize) -> Vec<f64> {
+    let frames = (x.len() / c) as isize;
+    let mut out = Vec::with_capacity(x.len() + 2 * pad * c);
+    for i in 0..frames + 2 * pad as isize {
+        let mut f = i - pad as isize;
+        if frames == 1 {
+            f = 0;
+        }
+        while f < 0 || f >= frames {
+            f = if f < 0 { -f } else { 2 * (frames - 1) - f };
+        }
+        out.extend_from_slice(&x[f as usize * c..(f as usize + 1) * c]);
+    }
+    out
+}
+
+/// The discrete Fourier transform along time, bins `0..=len/2`, of each
+/// channel of the `len` frames from `start`, multiplied by `window`: a
+/// `c x (len/2 + 1)` matrix.
+fn segment_spectrum(x: &[f64], c: usize, start: usize, len: usize, window: &[f64]) -> DMatrix<C64> {
+    let bins = len / 2 + 1;
+    let mut out = DMatrix::<C64>::zeros(c, bins);
+    for (t, &w) in window.iter().enumerate() {
+        let frame = &x[(start + t) * c..(start + t + 1) * c];
+        for b in 0..bins {
+            let angle = -2.0 * PI * ((b * t) % len) as f64 / len as f64;
+            let e = C64::new(angle.cos(), angle.sin()) * w;
+            let mut column = out.column_mut(b);
+            for (o, &v) in column.iter_mut().zip(frame) {
+                *o += e * v;
+            }
+        }
+    }
+    out
+}
+
+/// The real frames of a segment from its bins `0..=len/2` (the other bins
+/// are their conjugates): `len x c`, frame-major.
+fn inverse_segment(spectrum: &DMatrix<C64>, len: usize) -> Vec<f64> {
+    let c = spectrum.nrows();
+    let bins = spectrum.ncols();
+    let mut out = vec![0.0; len * c];
+    for t in 0..len {
+        let frame = &mut out[t * c..(t + 1) * c];
+        for b in 0..bins {
+            let angle = 2.0 * PI * ((b * t) % len) as f64 / len as f64;
+            let e = C64::new(angle.cos(), angle.sin());
+            let scale = if b == 0 || 2 * b == len { 1.0 } else { 2.0 } / len as f64;
+            for (o, &v) in frame.iter_mut().zip(spectrum.column(b).iter()) {
+                *o += scale * (v * e).re;
+            }
+        }
+    }
+    out
+}
+
+impl WienerFilter {
+    /// Fits the filter to clean takes (all on the rig of the first; others
+    /// are counted and left out): the signal spectra from every take, the
+    /// noise covariance from noising up to 64 of them at `noise_sigma_deg`
+    /// with `noise` (seeded).
+    pub fn fit(
+        takes: &[&Motion],
+        noise: &RandomNoise,
+        noise_sigma_deg: f32,
+        segment: usize,
+        seed: u64,
+    ) -> Result<WienerFilter> {
+        if segment < 8 || segment % 2 == 1 {
+            return Err(CleanError::Invalid(format!(
+                "a Wiener segment must be an even number of frames, at least 8 (got {segment})"
+            )));
+        }
+        let first = takes
+            .first()
+            .ok_or_else(|| CleanError::Invalid("no takes to fit a Wiener filter to".into()))?;
+        let layout = FeatureLayout::new(first.skeleton(), Representation::Rot6d)?;
+        let joints = joint_names(first, &layout);
+        let same_rig: Vec<&Motion> = takes
+            .iter()
+            .copied()
+            .filter(|m| {
+                FeatureLayout::new(m.skeleton(), Representation::Rot6d)
+                    .is_ok_and(|l| joint_names(m, &l) == joints)
+            })
+            .collect();
+        let c = layout.channels();
+        let bins = segment / 2 + 1;
+        let window: Vec<f64> = (0..segment).map(|t| hann(t, segment)).collect();
+        let window_power: f64 = window.iter().map(|w| w * w).sum();
+        // Welch: the mean of X X^H over half-overlapping Hann segments.
+        let per_take: Vec<(Vec<DMatrix<C64>>, usize)> = same_rig
+            .par_iter()
+            .map(|m| {
+                let (x, _) = centred(&layout.encode(m), c);
+                let frames = x.len() / c;
+                let mut sums = vec![DMatrix::<C64>::zeros(c, c); bins];
+                let mut count = 0;
+                let mut start = 0;
+                while start + segment <= frames {
+                    let spectrum = segment_spectrum(&x, c, start, segment, &window);
+                    for (b, sum) in sums.iter_mut().enumerate() {
+                        let column = spectrum.column(b);
+                        sum.ger(
+                            C64::new(1.0, 0.0),
+                            &column,
+                            &column.map(|v| v.conj()),
+                            C64::new(1.0, 0.0),
+                        );
+                    }
+                    count += 1;
+                    start += segment / 2;
+                }
+                (sums, count)
+            })
+            .collect();
+        let segments: usize = per_take.iter().map(|(_, n)| n).sum();
+        if segments == 0 {
+            return Err(CleanError::Invalid(format!(
+                "no take is {segment} frames long: nothing to estimate the spectra from"
+            )));
+        }
+        let mut spectra = vec![DMatrix::<C64>::zeros(c, c); bins];
+        for (sums, _) in per_take {
+            for (total, sum) in spectra.iter_mut().zip(sums) {
+                *total += sum;
+            }
+        }
+        let scale = C64::new(1.0 / (segments as f64 * window_power), 0.0);
+        for s in &mut spectra {
+            *s *= scale;
+        }
+        // N: the per-frame covariance of the noise of the features.
+        let noised: Vec<(DMatrix<f64>, usize)> = same_rig
+            .par_iter()
+            .take(64)
+            .enumerate()
+            .map(|(i, m)| {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(i as u64));
+                let noisy = add_random_noise_sigma(m, noise_sigma_deg, noise, &mut rng);
+                let (a, b) = (layout.encode(m), layout.encode(&noisy));
+                let mut sum = DMatrix::<f64>::zeros(c, c);
+                for (fa, fb) in a.chunks_exact(c).zip(b.chunks_exact(c)) {
+                    let d =
+                        DVector::from_iterator(c, fa.iter().zip(fb).map(|(p, q)| (q - p) as f64));
+                    sum.ger(1.0, &d, &d, 1.0);
+                }
+                (sum, m.frame_count())
+            })
+            .collect();
+        let noise_frames: usize = noised.iter().map(|(_, n)| n).sum();
+        let noise_cov = noised
+            .into_iter()
+            .fold(DMatrix::<f64>::zeros(c, c), |acc, (s, _)| acc + s)
+            / noise_frames.max(1) as f64;
+        let description = WienerDescription {
+            joints,
+            channels: c,
+            fps: first.fps() as f32,
+            segment,
+            noise: *noise,
+            noise_sigma_deg,
+            takes: same_rig.len(),
+            frames: same_rig.iter().map(|m| m.frame_count()).sum(),
+            segments,
+            other_rig_takes: takes.len() - same_rig.len(),
+        };
+        Ok(Self::from_parts(description, spectra, noise_cov))
+    }
+
+    /// Builds the per-bin bases of (1) from the spectra and `N`.
+    fn from_parts(
+        description: WienerDescription,
+        spectra: Vec<DMatrix<C64>>,
+        noise: DMatrix<f64>,
+    ) -> WienerFilter {
+        let c = noise.nrows();
+        // A joint's 6 features have 3 degrees of freedom, so N is singular:
+        // a ridge of 1e-6 of its mean variance stands for the directions
+        // with (almost) no noise, which the filter then passes through.
+        let ridge = 1e-6 * noise.trace() / c as f64 + 1e-12;
+        let eigen = SymmetricEigen::new(&noise + DMatrix::<f64>::identity(c, c) * ridge);
+        let root = |power: f64| {
+            let d = DMatrix::from_diagonal(&eigen.eigenvalues.map(|v| v.max(ridge).powf(power)));
+            (&eigen.eigenvectors * d * eigen.eigenvectors.transpose()).map(|v| C64::new(v, 0.0))
+        };
+        let (half, inverse_half) = (root(0.5), root(-0.5));
+        // The noise level is judged only in the directions the noise model
+        // puts noise in: in the others the whitening has nothing but the
+        // ridge to divide by, and any power the training spectra did not
+        // foresee there would be taken for noise.
+        let noise_eigen = SymmetricEigen::new(noise.clone());
+        let largest = noise_eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let noisy: Vec<usize> = (0..c)
+            .filter(|&i| noise_eigen.eigenvalues[i] > 1e-6 * largest && largest > 0.0)
+            .collect();
+        let judge_basis = DMatrix::from_fn(noisy.len(), c, |k, j| {
+            let i = noisy[k];
+            C64::new(
+                noise_eigen.eigenvectors[(j, i)] / noise_eigen.eigenvalues[i].sqrt(),
+                0.0,
+            )
+        });
+        let hermitian_eigen = |m: DMatrix<C64>| {
+            // Hermitian up to rounding; symmetrise before the solver.
+            SymmetricEigen::new((&m + m.adjoint()) * C64::new(0.5, 0.0))
+        };
+        let bins = spectra
+            .par_iter()
+            .map(|s| {
+                let eigen = hermitian_eigen(&inverse_half * s * &inverse_half);
+                let judged = hermitian_eigen(&judge_basis * s * judge_basis.adjoint());
+                Bin {
+                    to_white: eigen.eigenvectors.adjoint() * &inverse_half,
+                    from_white: &half * &eigen.eigenvectors,
+                    lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                    judge: judged.eigenvectors.adjoint() * &judge_basis,
+                    judge_lambda: judged.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                }
+            })
+            .collect();
+        WienerFilter {
+            description,
+            spectra,
+            noise,
+            bins,
+        }
+    }
+
+    /// The features of `motion`'s rig, or an error naming both rigs.
+    fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
+        let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
+        let names = joint_names(motion, &layout);
+        if names != self.description.joints {
+            let d = &self.description.joints;
+            return Err(CleanError::Invalid(format!(
+                "the Wiener filter was fitted to a rig of {} joints with rotations ({}, ...), \
+                 this take has {} ({}, ...): clean it with --filter, or fit one to this rig \
+                 with `mocap clean train --wiener`",
+                d.len(),
+                d[..d.len().min(3)].join(", "),
+                names.len(),
+                names[..names.len().min(3)].join(", "),
+            )));
+        }
+        Ok(layout)
+    }
+
+    /// Cleans `motion` (root translation kept); `sigma_deg` forces the noise
+    /// level, `None` estimates it by (2).
+    pub fn clean(
+        &self,
+        motion: &Motion,
+        sigma_deg: Option<f64>,
+    ) -> Result<(Motion, WienerOutcome)> {
+        let layout = self.layout_for(motion)?;
+        if motion.frame_count() == 0 {
+            return Ok((motion.clone(), WienerOutcome { sigma_deg: 0.0 }));
+        }
+        let mut features = layout.encode(motion);
+        let outcome = self.filter_features(&mut features, sigma_deg);
+        let mut out = motion.clone();
+        layout.decode_into(&features, &mut out);
+        Ok((out, outcome))
+    }
+
+    /// Filters features of the fitted rig in place (frames x channels).
+    pub fn filter_features(&self, features: &mut [f32], sigma_deg: Option<f64>) -> WienerOutcome {
+        let c = self.description.channels;
+        let len = self.description.segment;
+        let (x, mean) = centred(features, c);
+        let frames = x.len() / c;
+        let padded = reflect_pad(&x, c, len);
+        let total = padded.len() / c;
+        let window: Vec<f64> = (0..len).map(|t| hann(t, len).sqrt()).collect();
+        let starts: Vec<usize> = (0..)
+            .map(|k| k * len / 2)
+            .take_while(|s| s + len <= total)
+            .collect();
+        // Whitened coefficients z = V^H N^-1/2 X of every segment and bin,
+        // and those of the noisy directions (for judging the noise level).
+        let (white, judged): (Vec<SegmentCoefficients>, Vec<SegmentCoefficients>) = starts
+            .par_iter()
+            .map(|&s| {
+                let spectrum = segment_spectrum(&padded, c, s, len, &window);
+                self.bins
+                    .iter()
+                    .enumerate()
+                    .map(|(b, bin)| {
+                        (
+                            &bin.to_white * spectrum.column(b),
+                            &bin.judge * spectrum.column(b),
+                        )
+                    })
+                    .unzip()
+            })
+            .unzip();
+        // The noise level is judged on the segments inside the take: the
+        // mirrored padding bends every channel at the take's ends, power
+        // the clean spectra never had (all segments when the take is
+        // shorter than one).
+        let inside: Vec<&SegmentCoefficients> = starts
+            .iter()
+            .zip(&judged)
+            .filter(|(&s, _)| s >= len && s + len <= len + frames)
+            .map(|(_, z)| z)
+            .collect();
+        let sigma = sigma_deg.unwrap_or_else(|| {
+            if inside.is_empty() {
+                self.estimate_sigma_deg(&judged.iter().collect::<Vec<_>>(), &window)
+            } else {
+                self.estimate_sigma_deg(&inside, &window)
+            }
+        });
+        let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
+        let filtered: Vec<Vec<f64>> = white
+            .par_iter()
+            .map(|z| {
+                let mut spectrum = DMatrix::<C64>::zeros(c, self.bins.len());
+                for (b, (bin, z)) in self.bins.iter().zip(z).enumerate() {
+                    let gained = DVector::from_iterator(
+                        c,
+                        z.iter()
+                            .zip(&bin.lambda)
+                            .map(|(v, &l)| v * (l / (l + s).max(1e-300))),
+                    );
+                    spectrum.set_column(b, &(&bin.from_white * gained));
+                }
+                inverse_segment(&spectrum, len)
+            })
+            .collect();
+        // Overlap-add with the synthesis window (analysis x synthesis = Hann).
+        let mut sum = vec![0.0f64; padded.len()];
+        for (&start, y) in starts.iter().zip(&filtered) {
+            for (t, &w) in window.iter().enumerate() {
+                let out = &mut sum[(start + t) * c..(start + t + 1) * c];
+                for (o, &v) in out.iter_mut().zip(&y[t * c..(t + 1) * c]) {
+                    *o += w * v;
+                }
+            }
+        }
+        for (i, f) in features.iter_mut().enumerate().take(frames * c) {
+            *f = (sum[len * c + i] + mean[i % c]) as f32;
+        }
+        WienerOutcome { sigma_deg: sigma }
+    }
+
+    /// The noise level of largest marginal likelihood (2), from the
+    /// coefficients of the noisy directions (`Bin::judge`) of segments.
+    fn estimate_sigma_deg(&self, judged: &[&SegmentCoefficients], window: &[f64]) -> f64 {
+        // Coefficients of a window v have variance (lambda + s) sum(v^2)
+        // in the units the spectra were normalised to.
+        let norm: f64 = window.iter().map(|v| v * v).sum();
+        let len = self.description.segment;
+        // Power per bin and coordinate, summed over segments.
+        let mut power: Vec<Vec<f64>> = self
+            .bins
+            .iter()
+            .map(|bin| vec![0.0; bin.judge_lambda.len()])
+            .collect();
+        for z in judged {
+            for (p, zb) in power.iter_mut().zip(z.iter()) {
+                for (pi, v) in p.iter_mut().zip(zb.iter()) {
+                    *pi += v.norm_sqr() / norm;
+                }
+            }
+        }
+        let n = judged.len() as f64;
+        let log_likelihood = |s: f64| -> f64 {
+            let mut total = 0.0;
+            for (b, (bin, p)) in self.bins.iter().zip(&power).enumerate() {
+                let weight = if b == 0 || 2 * b == len { 0.5 } else { 1.0 };
+                let mut sum = 0.0;
+                for (&l, &pi) in bin.judge_lambda.iter().zip(p) {
+                    let v = l + s;
+                    sum += -n * v.ln() - pi / v;
+                }
+                total += weight * sum;
+            }
+            total
+        };
+        let reference = self.description.noise_sigma_deg as f64;
+        sigma_grid_deg()
+            .map(|sigma| (sigma, log_likelihood((sigma / reference).powi(2))))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0.0, |(sigma, _)| sigma)
+    }
+
+    /// Writes the filter (atomically) in the checkpoint format the networks use.
+    pub fn save(&self, path: &Path, data: serde_json::Value) -> Result<()> {
+        let device = Device::flex();
+        let c = self.description.channels;
+        let bins = self.spectra.len();
+        let part = |f: fn(&C64) -> f64| -> Vec<f32> {
+            self.spectra
+                .iter()
+                .flat_map(|s| {
+                    s.transpose()
+                        .iter()
+                        .map(f)
+                        .map(|v| v as f32)
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        };
+        let tensors = WienerTensors {
+            spectra_re: Param::from_tensor(Tensor::from_data(
+                TensorData::new(part(|v| v.re), [bins, c, c]),
+                &device,
+            )),
+            spectra_im: Param::from_tensor(Tensor::from_data(
+                TensorData::new(part(|v| v.im), [bins, c, c]),
+                &device,
+            )),
+            noise: Param::from_tensor(Tensor::from_data(
+                TensorData::new(
+                    self.noise
+                        .transpose()
+                        .iter()
+                        .map(|&v| v as f32)
+                        .collect::<Vec<_>>(),
+                    [c, c],
+                ),
+                &device,
+            )),
+        };
+        let header = CheckpointHeader {
+            kind: WIENER_KIND.into(),
+            kind_version: WIENER_KIND_VERSION,
+            config: serde_json::to_value(&self.description)
+                .map_err(|e| CleanError::Invalid(format!("describing the filter: {e}")))?,
+            data,
+            training: serde_json::Value::Null,
+        };
+        save_weights(path, &tensors, &header)?;
+        Ok(())
+    }
+
+    /// Reads a file written by [`WienerFilter::save`]; `origin` names the
+    /// bytes in errors.
+    pub fn from_bytes(bytes: Vec<u8>, origin: &Path) -> Result<WienerFilter> {
+        let header = header_from_bytes(&bytes, origin)?;
+        let bad = |m: String| CleanError::Invalid(format!("{}: {m}", origin.display()));
+        if header.kind != WIENER_KIND {
+            return Err(bad(format!(
+                "a `{}` file, expected `{WIENER_KIND}`",
+                header.kind
+            )));
+        }
+        if header.kind_version != WIENER_KIND_VERSION {
+            return Err(bad(format!(
+                "Wiener filter version {}, this build reads {WIENER_KIND_VERSION}",
+                header.kind_version
+            )));
+        }
+        let description: WienerDescription = serde_json::from_value(header.config)
+            .map_err(|e| bad(format!("bad Wiener filter description: {e}")))?;
+        let c = description.channels;
+        if description.segment < 8 || description.segment % 2 == 1 || c == 0 {
+            return Err(bad(
+                "bad Wiener filter description: segment or channels".into()
+            ));
+        }
+        let bins = description.segment / 2 + 1;
+        let device = Device::flex();
+        let empty = WienerTensors {
+            spectra_re: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
+            spectra_im: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
+            noise: Param::from_tensor(Tensor::zeros([c, c], &device)),
+        };
+        let tensors = load_weights_from_bytes(bytes, origin, empty)?;
+        let read = |t: Tensor<3>| -> Result<Vec<f32>> {
+            t.into_data()
+                .try_to_vec::<f32>()
+                .map_err(|e| bad(format!("reading the spectra: {e:?}")))
+        };
+        let re = read(tensors.spectra_re.val())?;
+        let im = read(tensors.spectra_im.val())?;
+        let noise: Vec<f32> = tensors
+            .noise
+            .val()
+            .into_data()
+            .try_to_vec::<f32>()
+            .map_err(|e| bad(format!("reading the noise covariance: {e:?}")))?;
+        if re.iter().chain(&im).chain(&noise).any(|v| !v.is_finite()) {
+            return Err(bad("the Wiener filter holds non-finite numbers".into()));
+        }
+        let spectra = (0..bins)
+            .map(|b| {
+                DMatrix::from_fn(c, c, |i, j| {
+                    let k = (b * c + i) * c + j;
+                    C64::new(re[k] as f64, im[k] as f64)
+                })
+            })
+            .collect();
+        let noise = DMatrix::from_fn(c, c, |i, j| noise[i * c + j] as f64);
+        Ok(Self::from_parts(description, spectra, noise))
+    }
+
+    /// The same filter with every channel on its own: only the diagonals
+    /// of the spectra and of `N` kept (what a per-channel filter can know;
+    /// for comparisons).
+    pub fn per_channel(&self) -> WienerFilter {
+        let diagonal = |m: &DMatrix<C64>| DMatrix::from_diagonal(&m.diagonal());
+        Self::from_parts(
+            self.description.clone(),
+            self.spectra.iter().map(diagonal).collect(),
+            DMatrix::from_diagonal(&self.noise.diagonal()),
+        )
+    }
+
+    /// Reads a Wiener filter file.
+    pub fn load(path: &Path) -> Result<WienerFilter> {
+        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+        Self::from_bytes(bytes, path)
+    }
+}
+
+/// Options of `mocap clean train --wiener`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WienerFitOptions {
+    /// Folders or files of clean BVH takes; the training split is used.
+    pub inputs: Vec<PathBuf>,
+    pub out: PathBuf,
+    pub split: SplitFractions,
+    /// Frames per Fourier segment (32 measured best of 16-128 on Bandai,
+    /// bench/results/clean.md).
+    pub segment: usize,
+    pub noise: RandomNoise,
+    /// The level `N` is measured at (the noise is nearly linear in it).
+    pub noise_sigma_deg: f32,
+    pub seed: u64,
+    /// Fit to at most this many training takes (quick runs and tests).
+    pub max_train_takes: Option<usize>,
+}
+
+impl Default for WienerFitOptions {
+    fn default() -> Self {
+        WienerFitOptions {
+            inputs: Vec::new(),
+            out: PathBuf::from("clean-wiener.safetensors"),
+            split: SplitFractions::default(),
+            segment: 32,
+            noise: RandomNoise::default(),
+            noise_sigma_deg: 5.0,
+            seed: 1,
+            max_train_takes: None,
+        }
+    }
+}
+
+/// What fitting wrote.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WienerFitReport {
+    pub model: PathBuf,
+    pub description: WienerDescription,
+    pub data: DataDescription,
+    pub seconds: f64,
+}
+
+/// Fits a filter to the training takes of `options.inputs` and writes it.
+pub fn fit_files(options: &WienerFitOptions) -> Result<WienerFitReport> {
+    let started = Instant::now();
+    let paths = list_bvh(&options.inputs)?;
+    let mut train_paths = paths_in_split(&paths, Split::Train, &options.split);
+    if let Some(max) = options.max_train_takes {
+        train_paths.truncate(max);
+    }
+    let takes = load_takes(&train_paths)?;
+    let motions: Vec<&Motion> = takes.iter().map(|t| &t.motion).collect();
+    let filter = WienerFilter::fit(
+        &motions,
+        &options.noise,
+        options.noise_sigma_deg,
+        options.segment,
+        options.seed,
+    )?;
+    let valid_paths = paths_in_split(&paths, Split::Validation, &options.split);
+    let data = DataDescription {
+        inputs: options
+            .inputs
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
+        split: options.split,
+        train_takes: filter.description.takes,
+        train_frames: filter.description.frames,
+        validation_takes: valid_paths.len(),
+        validation_frames: 0,
+        test_takes: paths_in_split(&paths, Split::Test, &options.split).len(),
+        fps: filter.description.fps as f64,
+        held_out: paths
+            .iter()
+            .map(|p| take_name(p))
+            .filter(|n| split_of(n, &options.split) != Split::Train)
+            .collect(),
+    };
+    let data_json = serde_json::to_value(&data)
+        .map_err(|e| CleanError::Invalid(format!("describing the data: {e}")))?;
+    filter.save(&options.out, data_json)?;
+    Ok(WienerFitReport {
+        model: options.out.clone(),
+        description: filter.description,
+        data,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The names of the joints of `layout` (those with rotation channels).
+fn joint_names(motion: &Motion, layout: &FeatureLayout) -> Vec<String> {
+    layout
+        .joints
+        .iter()
+        .map(|&j| motion.skeleton().joint(j).name.clone())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::rotation_error_deg;
+    use crate::test_support::synthetic_motion_phase;
+
+    /// Fitted to eight 8-s takes of the synthetic 5-joint chain.
+    fn fitted() -> WienerFilter {
+        let takes: Vec<Motion> = (0..8)
+            .map(|k| synthetic_motion_phase(240, 5, 0.7 * k as f32))
+            .collect();
+        let refs: Vec<&Motion> = takes.iter().collect();
+        WienerFilter::fit(&refs, &RandomNoise::default(), 5.0, 32, 1).unwrap()
+    }
+
+    #[test]
+    fn the_short_time_transform_gives_back_its_input() {
+        // With every gain 1 the analysis, synthesis and overlap-add must
+        // return the features, for takes shorter and longer than a segment.
+        let c = 6;
+        let bins = (0..17)
+            .map(|_| Bin {
+                to_white: DMatrix::identity(c, c),
+                from_white: DMatrix::identity(c, c),
+                lambda: vec![1e30; c],
+                judge: DMatrix::identity(c, c),
+                judge_lambda: vec![1e30; c],
+            })
+            .collect();
+        let filter = WienerFilter {
+            description: WienerDescription {
+                joints: vec!["j".into()],
+                channels: c,
+                fps: 30.0,
+                segment: 32,
+                noise: RandomNoise::default(),
+                noise_sigma_deg: 5.0,
+                takes: 0,
+                frames: 0,
+                segments: 0,
+                other_rig_takes: 0,
+            },
+            spectra: Vec::new(),
+            noise: DMatrix::zeros(c, c),
+            bins,
+        };
+        for frames in [1, 5, 31, 32, 33, 100] {
+            let x: Vec<f32> = (0..frames * c)
+                .map(|i| ((i * 37 % 101) as f32 / 50.0 - 1.0) + (i / c) as f32 * 0.01)
+                .collect();
+            let mut y = x.clone();
+            filter.filter_features(&mut y, Some(1.0));
+            let most = x
+                .iter()
+                .zip(&y)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f32::max);
+            assert!(most < 1e-5, "{frames} frames: off by {most}");
+        }
+    }
+
+    #[test]
+    fn it_removes_random_noise_and_leaves_clean_takes_nearly_alone() {
+        let filter = fitted();
+        let clean = synthetic_motion_phase(300, 5, 0.35);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let noisy = add_random_noise_sigma(&clean, 5.0, &RandomNoise::default(), &mut rng);
+        let (cleaned, outcome) = filter.clean(&noisy, None).unwrap();
+        let before = rotation_error_deg(&clean, &noisy);
+        let after = rotation_error_deg(&clean, &cleaned);
+        assert!(after < 0.4 * before, "{before} -> {after} degrees");
+        assert!(
+            (2.5..10.0).contains(&outcome.sigma_deg),
+            "noise of 5 degrees estimated at {}",
+            outcome.sigma_deg
+        );
+        for f in 0..noisy.frame_count() {
+            assert_eq!(cleaned.root_translation(f), noisy.root_translation(f));
+        }
+        let (untouched, outcome) = filter.clean(&clean, None).unwrap();
+        let change = rotation_error_deg(&clean, &untouched);
+        assert!(
+            change < 0.25 * after,
+            "a clean take changed by {change} degrees"
+        );
+        assert!(
+            outcome.sigma_deg < 1.0,
+            "a clean take's noise: {}",
+            outcome.sigma_deg
+        );
+    }
+
+    #[test]
+    fn files_round_trip_and_other_rigs_are_refused() {
+        let filter = fitted();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("wiener.safetensors");
+        filter.save(&path, serde_json::Value::Null).unwrap();
+        let loaded = WienerFilter::load(&path).unwrap();
+        assert_eq!(loaded.description, filter.description);
+        let clean = synthetic_motion_phase(120, 5, 0.35);
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let noisy = add_random_noise_sigma(&clean, 3.0, &RandomNoise::default(), &mut rng);
+        let (a, sa) = filter.clean(&noisy, None).unwrap();
+        let (b, sb) = loaded.clean(&noisy, None).unwrap();
+        // The file keeps the spectra in f32.
+        assert!(rotation_error_deg(&a, &b) < 0.01);
+        assert!((sa.sigma_deg - sb.sigma_deg).abs() < 0.15);
+        // A network reader refuses it by name, and the dispatcher knows it.
+        let error = crate::infer::CleanModel::load(&path, Default::default())
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains(WIENER_KIND), "{error}");
+        assert!(matches!(
+            crate::infer::ModelFile::load(&path, Default::default()).unwrap(),
+            crate::infer::ModelFile::Wiener(_)
+        ));
+        let error = filter
+            .clean(&synthetic_motion_phase(50, 4, 0.0), None)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("fitted to a rig of 5 joints"), "{error}");
+        // Truncated files are errors, not panics.
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(WienerFilter::from_bytes(bytes[..bytes.len() / 2].to_vec(), &path).is_err());
+    }
+}
