@@ -1,7 +1,10 @@
 //! Inference and training speed of a denoiser (a benchmark, not a test).
 //!
 //! cargo run --release -p mocap-clean --example clean_speed -- --data ../shared/data/bandai \
-//!     [--model FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
+//!     [--model FILE] [--base-wiener FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
+//!
+//! `--base-wiener`: the Wiener filter file a model on a Wiener base was trained with (its training
+//! speed needs it; the model file carries only what cleaning needs).
 //!
 //! Inference: a clip of `frames` frames (takes of the data set joined end to
 //! end), cleaned `repeats` times; frames per second of `CleanModel::clean`
@@ -24,6 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut data, mut model_path, mut device) = (None, None, mocap_nn::device::DeviceChoice::Cpu);
     let (mut frames, mut repeats, mut train_steps, mut batch) =
         (1800usize, 5usize, 5usize, 512usize);
+    let mut base_wiener = None;
     let mut i = 0;
     while i < args.len() {
         let v = args
@@ -33,6 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match args[i].as_str() {
             "--data" => data = Some(PathBuf::from(v)),
             "--model" => model_path = Some(PathBuf::from(v)),
+            "--base-wiener" => base_wiener = Some(PathBuf::from(v)),
             "--device" => device = v.parse()?,
             "--frames" => frames = v.parse()?,
             "--repeats" => repeats = v.parse()?,
@@ -84,6 +89,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         clip.fps(),
         model.parameter_count()
     );
+    if train_steps > 0 && model.description.base_wiener.is_some() && base_wiener.is_none() {
+        return Err(
+            "the model corrects a Wiener filter: give its file with --base-wiener to time training"
+                .into(),
+        );
+    }
     if train_steps > 0 {
         let dir = tempfile_dir()?;
         let options = TrainOptions {
@@ -94,6 +105,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             frame: model.description.frame,
             base_filter: model.description.base_filter,
             base_context: model.description.base_context,
+            base_wiener: base_wiener.clone(),
             epochs: 1,
             steps_per_epoch: train_steps,
             batch_size: batch,

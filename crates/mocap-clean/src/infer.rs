@@ -26,10 +26,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::FeatureLayout;
-use crate::filters::{filter_features, filter_motion, Filter};
+use crate::filters::{filter_motion, Filter};
 use crate::model::{Denoiser, Head};
 use crate::spikes::{SpikeDetector, SpikeOptions};
-use crate::training::{window_base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
+use crate::training::{
+    window_base, Base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION,
+};
 use crate::wiener::{WienerFilter, WIENER_KIND};
 use crate::{CleanError, Result};
 
@@ -49,6 +51,9 @@ pub struct CleanModel {
     pub source: PathBuf,
     model: Denoiser,
     device: Device,
+    /// The learned filter the network corrects
+    /// ([`ModelDescription::base_wiener`]).
+    base_wiener: Option<WienerFilter>,
 }
 
 impl std::fmt::Debug for CleanModel {
@@ -103,13 +108,27 @@ impl CleanModel {
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad model description: {e}")))?;
         let device = device.device()?;
-        let model = description.network.init(&device)?;
-        let model = load_weights_from_bytes(bytes, origin, model)?;
+        let mut model = description.network.init(&device)?;
+        if let Some(wiener) = &description.base_wiener {
+            WienerFilter::check_description(wiener).map_err(bad)?;
+            if description.base_filter.is_some() {
+                return Err(bad("a base filter and a base Wiener filter at once".into()));
+            }
+            model.base = Some(WienerFilter::empty_tensors(wiener));
+        }
+        let mut model = load_weights_from_bytes(bytes, origin, model)?;
+        let base_wiener = match (model.base.take(), &description.base_wiener) {
+            (Some(tensors), Some(wiener)) => {
+                Some(WienerFilter::from_tensors(wiener.clone(), tensors).map_err(bad)?)
+            }
+            _ => None,
+        };
         Ok(CleanModel {
             description,
             source: origin.to_path_buf(),
             model,
             device,
+            base_wiener,
         })
     }
 
@@ -159,10 +178,15 @@ impl CleanModel {
         let features = layout.encode(motion);
         // A base filter that sees the whole take runs once, before the take
         // is cut into windows (see `ModelDescription::base_context`).
-        let filtered_take = match &self.description.base_filter {
-            Some(filter) if self.description.base_context > 0 => {
+        let base = match (&self.description.base_filter, &self.base_wiener) {
+            (Some(filter), _) => Some(Base::Classical(*filter, self.description.fps)),
+            (None, Some(wiener)) => Some(Base::Wiener(wiener)),
+            (None, None) => None,
+        };
+        let filtered_take = match &base {
+            Some(base) if self.description.base_context > 0 => {
                 let mut filtered = features.clone();
-                filter_features(&mut filtered, c, filter, self.description.fps);
+                base.apply(&mut filtered, c);
                 Some(filtered)
             }
             _ => None,
@@ -203,11 +227,11 @@ impl CleanModel {
                 let s = (start_index + b) * hop;
                 let mut w = padded[s * c..(s + t) * c].to_vec();
                 let recentering = layout.recenter(&mut w);
-                let filtered = self.description.base_filter.as_ref().map(|filter| {
+                let filtered = base.as_ref().map(|base| {
                     let around = padded_filtered
                         .as_deref()
                         .map(|take| &take[s * c..(s + t) * c]);
-                    window_base(&w, around, &recentering, filter, c, self.description.fps)
+                    window_base(&w, around, &recentering, base, c)
                 });
                 offsets.push(recentering);
                 if let Some(filtered) = filtered {
@@ -265,6 +289,19 @@ impl CleanModel {
         let mut out = motion.clone();
         layout.decode_into(&cleaned, &mut out);
         Ok(out)
+    }
+
+    /// The learned filter the network corrects, if it corrects one
+    /// ([`ModelDescription::base_wiener`]).
+    pub fn base_wiener(&self) -> Option<&WienerFilter> {
+        self.base_wiener.as_ref()
+    }
+
+    /// Zeroes the network's output layer, so that the model gives its base
+    /// filter's output (tests of what is around the network).
+    #[cfg(test)]
+    pub(crate) fn zero_output(&mut self) {
+        self.model.zero_output();
     }
 
     /// Number of trainable numbers of the network.
@@ -477,6 +514,7 @@ mod tests {
             fps: 30.0,
             base_filter: None,
             base_context: 0,
+            base_wiener: None,
         };
         description_bytes(&model, &description)
     }
@@ -514,6 +552,7 @@ mod tests {
             fps: 30.0,
             base_filter: Some(filter),
             base_context: 64,
+            base_wiener: None,
         };
         let clean = crate::test_support::synthetic_motion_phase(150, joints, 0.3);
         let noise = crate::noise::RandomNoise::default();

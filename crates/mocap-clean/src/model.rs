@@ -28,6 +28,7 @@ use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor};
 use serde::{Deserialize, Serialize};
 
+use crate::wiener::WienerTensors;
 use crate::{CleanError, Result};
 
 /// Sizes of the network. The defaults are the small CPU setting;
@@ -161,6 +162,7 @@ impl DenoiserConfig {
             decoder,
             output: conv(self.width, self.output_channels()),
             residual: self.head == Head::Correction,
+            base: None,
         })
     }
 
@@ -217,6 +219,11 @@ pub struct Denoiser {
     /// a spike detector). Not a weight: it comes from the configuration.
     #[module(skip)]
     residual: bool,
+    /// The learned Wiener filter the network corrects, when it does
+    /// ([`crate::training::ModelDescription::base_wiener`]): not trained and
+    /// not used by `forward`; it rides along so that one file holds the
+    /// whole model. Attached only when the model is written or read.
+    pub(crate) base: Option<WienerTensors>,
 }
 
 impl Denoiser {

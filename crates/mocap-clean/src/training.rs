@@ -41,6 +41,7 @@ use crate::loss::{binary_cross_entropy_with_logits, derivative_loss, position_lo
 use crate::model::{Denoiser, DenoiserConfig, Head};
 use crate::noise::{add_noise_with_spikes, NoiseConfig, Spike};
 use crate::spikes::spike_mask;
+use crate::wiener::{WienerDescription, WienerFilter};
 use crate::{CleanError, Result};
 
 /// The kind written in checkpoint headers.
@@ -80,6 +81,40 @@ pub struct ModelDescription {
     /// a 32-frame window is poor) is trained with nearly what it sees in use.
     #[serde(default)]
     pub base_context: usize,
+    /// A learned Wiener filter ([`crate::wiener`]) the network corrects
+    /// instead of a classical one (same rule as `base_filter`, which is then
+    /// `None`); its numbers are stored in the model's file with the
+    /// network's weights.
+    #[serde(default)]
+    pub base_wiener: Option<WienerDescription>,
+}
+
+impl ModelDescription {
+    /// Whether the network corrects a base filter rather than its input.
+    pub fn has_base(&self) -> bool {
+        self.base_filter.is_some() || self.base_wiener.is_some()
+    }
+}
+
+/// What a model's network corrects, ready to run: a classical filter at a
+/// frame rate ([`ModelDescription::base_filter`]) or a learned Wiener filter
+/// ([`ModelDescription::base_wiener`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Base<'a> {
+    Classical(Filter, f32),
+    Wiener(&'a WienerFilter),
+}
+
+impl Base<'_> {
+    /// Filters `features` (frames x `channels`) in place.
+    pub(crate) fn apply(&self, features: &mut [f32], channels: usize) {
+        match self {
+            Base::Classical(filter, fps) => filter_features(features, channels, filter, *fps),
+            Base::Wiener(wiener) => {
+                wiener.filter_features(features, None);
+            }
+        }
+    }
 }
 
 /// Options of `mocap clean train`.
@@ -103,6 +138,11 @@ pub struct TrainOptions {
     /// See [`ModelDescription::base_context`].
     #[serde(default)]
     pub base_context: usize,
+    /// A Wiener filter file (`mocap clean train --wiener`) the network
+    /// corrects, instead of `base_filter` (see
+    /// [`ModelDescription::base_wiener`]).
+    #[serde(default)]
+    pub base_wiener: Option<PathBuf>,
     /// Network sizes; `channels` is set from the data.
     pub network: DenoiserConfig,
     pub epochs: usize,
@@ -148,6 +188,7 @@ impl Default for TrainOptions {
             frame: RotationFrame::Local,
             base_filter: None,
             base_context: 0,
+            base_wiener: None,
             network: DenoiserConfig::small(0),
             epochs: 20,
             steps_per_epoch: 40,
@@ -199,9 +240,8 @@ pub struct WindowSampler<'a> {
     layout: &'a FeatureLayout,
     frames: usize,
     noise: NoiseConfig,
-    /// The base filter of the model and the frame rate (see
-    /// [`ModelDescription::base_filter`]).
-    base: Option<(Filter, f32)>,
+    /// What the network corrects (see [`ModelDescription::base_filter`]).
+    base: Option<Base<'a>>,
     /// Frames of the take the noise and the base filter see on each side of
     /// the window ([`ModelDescription::base_context`]).
     context: usize,
@@ -251,10 +291,15 @@ impl<'a> WindowSampler<'a> {
     /// (see [`ModelDescription::base_filter`] and
     /// [`ModelDescription::base_context`]). The noise is then added to the
     /// window with its context, as it is added to whole takes in use.
-    pub fn with_base_filter(mut self, base: Option<Filter>, fps: f32, context: usize) -> Self {
-        self.base = base.map(|f| (f, fps));
+    pub(crate) fn with_base(mut self, base: Option<Base<'a>>, context: usize) -> Self {
+        self.base = base;
         self.context = if self.base.is_some() { context } else { 0 };
         self
+    }
+
+    /// [`WindowSampler::with_base`] for a classical filter at `fps`.
+    pub fn with_base_filter(self, base: Option<Filter>, fps: f32, context: usize) -> Self {
+        self.with_base(base.map(|f| Base::Classical(f, fps)), context)
     }
 
     /// Targets for a spike detector: the mask of the added spikes
@@ -365,15 +410,15 @@ impl<'a> WindowSampler<'a> {
                 let (mut xf, mut yf) = (crop(&xs), crop(&ys));
                 let recentering = self.layout.recenter(&mut xf);
                 recentering.apply(&mut yf);
-                if let Some((filter, fps)) = &self.base {
+                if let Some(base) = &self.base {
                     // With a context the filter sees the whole stretch, as
                     // it sees the whole take in use.
                     let around = (self.context > 0).then(|| {
                         let mut filtered = xs.clone();
-                        filter_features(&mut filtered, c, filter, *fps);
+                        base.apply(&mut filtered, c);
                         crop(&filtered)
                     });
-                    let base = window_base(&xf, around.as_deref(), &recentering, filter, c, *fps);
+                    let base = window_base(&xf, around.as_deref(), &recentering, base, c);
                     // The network's output N(x) stands for y - base(x) + x,
                     // so that the model's output N(x) - x + base(x) is y.
                     for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&base) {
@@ -409,9 +454,8 @@ pub(crate) fn window_base(
     window: &[f32],
     filtered_around: Option<&[f32]>,
     recentering: &Recentering,
-    filter: &Filter,
+    base: &Base,
     channels: usize,
-    fps: f32,
 ) -> Vec<f32> {
     match filtered_around {
         Some(around) => {
@@ -420,9 +464,9 @@ pub(crate) fn window_base(
             base
         }
         None => {
-            let mut base = window.to_vec();
-            filter_features(&mut base, channels, filter, fps);
-            base
+            let mut filtered = window.to_vec();
+            base.apply(&mut filtered, channels);
+            filtered
         }
     }
 }
@@ -525,7 +569,43 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         };
     }
     network.validate()?;
-    if options.base_context > 0 && options.base_filter.is_none() {
+    // A learned Wiener filter as the base: fitted to this rig's 6D local
+    // rotations, which the network must then read too.
+    let base_wiener = match &options.base_wiener {
+        None => None,
+        Some(path) => {
+            let wiener = WienerFilter::load(path)?;
+            let why = if options.base_filter.is_some() {
+                Some("give a base filter or a base Wiener filter, not both".to_string())
+            } else if options.spike_detector || options.position_weight > 0.0 {
+                Some("a spike detector or a position term has no base filter".to_string())
+            } else if options.representation != Representation::Rot6d
+                || options.frame != RotationFrame::Local
+            {
+                Some("a Wiener filter works on 6D local rotations (--representation rot6d --rotations local)".to_string())
+            } else if wiener.description.joints != joints {
+                Some(format!(
+                    "{} was fitted to another rig ({} joints with rotations, the data has {})",
+                    path.display(),
+                    wiener.description.joints.len(),
+                    joints.len()
+                ))
+            } else if (wiener.description.fps - fps).abs() > 1e-3 {
+                Some(format!(
+                    "{} was fitted at {} fps, the data is at {fps}",
+                    path.display(),
+                    wiener.description.fps
+                ))
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(CleanError::Invalid(why));
+            }
+            Some(wiener)
+        }
+    };
+    if options.base_context > 0 && options.base_filter.is_none() && base_wiener.is_none() {
         return Err(CleanError::Invalid(
             "a base context needs a base filter (the context is what that filter sees)".into(),
         ));
@@ -538,6 +618,12 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         fps,
         base_filter: options.base_filter,
         base_context: options.base_context,
+        base_wiener: base_wiener.as_ref().map(|w| w.description.clone()),
+    };
+    let base = match (&options.base_filter, &base_wiener) {
+        (Some(filter), _) => Some(Base::Classical(*filter, fps)),
+        (None, Some(wiener)) => Some(Base::Wiener(wiener)),
+        (None, None) => None,
     };
     let loss = if options.derivative_loss {
         LossWeights::derivative(fps)
@@ -580,10 +666,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         None
     };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps, options.base_context)
+        .with_base(base, options.base_context)
         .with_spike_targets(options.spike_detector);
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
-        .with_base_filter(options.base_filter, fps, options.base_context)
+        .with_base(base, options.base_context)
         .with_spike_targets(options.spike_detector);
     let shape = [options.batch_size, network.channels, network.window];
     let target_shape = [
@@ -721,13 +807,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         },
         |run, history| {
             let model = run.model.as_ref().expect("model");
+            // The written model carries its Wiener filter (not the training
+            // state, which only the network's weights and Adam's need).
+            let mut written = model.valid();
+            written.base = base_wiener.as_ref().map(WienerFilter::to_tensors);
             save_epoch(
                 &state,
                 model,
                 &run.optimizer,
                 history,
                 &options.out,
-                &model.valid(),
+                &written,
                 &header(history),
                 &plot,
                 &if options.spike_detector {
@@ -1042,6 +1132,82 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(error.contains("base filter"), "{error}");
+    }
+
+    #[test]
+    fn a_model_on_a_wiener_filter_carries_it_and_corrects_it() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let setup = tiny_setup(dir.path());
+        let wiener_path = dir.path().join("wiener.safetensors");
+        crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+            inputs: setup.inputs.clone(),
+            out: wiener_path.clone(),
+            split: setup.split,
+            ..Default::default()
+        })
+        .unwrap();
+        let options = TrainOptions {
+            out: dir.path().join("on-wiener.safetensors"),
+            base_wiener: Some(wiener_path.clone()),
+            base_context: 16,
+            ..setup
+        };
+        let report = train(&options).unwrap();
+        // The model's file alone is enough: the filter rides in it.
+        let kept = dir.path().join("kept.safetensors");
+        std::fs::rename(&wiener_path, &kept).unwrap();
+        let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let stored = model.description.base_wiener.clone().unwrap();
+        assert_eq!(stored.joints.len(), 4);
+        let clean = synthetic_motion_phase(90, 4, 0.2);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let noisy = crate::noise::add_random_noise_sigma(
+            &clean,
+            4.0,
+            &crate::noise::RandomNoise::default(),
+            &mut rng,
+        );
+        let trained = model.clean(&noisy, None).unwrap();
+        assert!(trained.values().iter().all(|v| v.is_finite()));
+        // With no correction the model is its Wiener filter over the take.
+        model.zero_output();
+        let zeroed = model.clean(&noisy, None).unwrap();
+        let wiener = crate::wiener::WienerFilter::from_bytes(
+            std::fs::read(dir.path().join("on-wiener.safetensors")).unwrap(),
+            Path::new("t"),
+        );
+        assert!(wiener.is_err(), "a model file is not a Wiener filter file");
+        let (filtered, _) = model_base(&model).clean(&noisy, None).unwrap();
+        let off = crate::eval::rotation_error_deg(&filtered, &zeroed);
+        assert!(off < 1e-3, "{off} degrees from the Wiener filter");
+        assert!(crate::eval::rotation_error_deg(&filtered, &noisy) > 0.1);
+        // Not both bases, and not on features a Wiener filter cannot read.
+        std::fs::rename(&kept, &wiener_path).unwrap();
+        for (wrong, why) in [
+            (
+                TrainOptions {
+                    base_filter: Some(Filter::ButterworthGcv { order: 2 }),
+                    ..options.clone()
+                },
+                "not both",
+            ),
+            (
+                TrainOptions {
+                    representation: Representation::ExpMap,
+                    ..options.clone()
+                },
+                "6D local rotations",
+            ),
+        ] {
+            let error = train(&wrong).unwrap_err().to_string();
+            assert!(error.contains(why), "{error}");
+        }
+    }
+
+    /// The Wiener filter a loaded model corrects.
+    fn model_base(model: &crate::infer::CleanModel) -> &crate::wiener::WienerFilter {
+        model.base_wiener().expect("a model on a Wiener filter")
     }
 
     #[test]

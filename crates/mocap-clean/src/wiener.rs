@@ -116,7 +116,7 @@ pub struct WienerDescription {
 /// `S(f)` (`[bins, c, c]`), and `N` (`[c, c]`). A burn module only so that
 /// it is written and read by the checkpoint code the networks use.
 #[derive(Module, Debug)]
-struct WienerTensors {
+pub(crate) struct WienerTensors {
     spectra_re: Param<Tensor<3>>,
     spectra_im: Param<Tensor<3>>,
     noise: Param<Tensor<2>>,
@@ -566,11 +566,13 @@ impl WienerFilter {
             .map_or(0.0, |(sigma, _)| sigma)
     }
 
-    /// Writes the filter (atomically) in the checkpoint format the networks use.
-    pub fn save(&self, path: &Path, data: serde_json::Value) -> Result<()> {
+    /// The stored numbers as a burn module (for a file of their own, or
+    /// inside a network's file when the network corrects this filter).
+    pub(crate) fn to_tensors(&self) -> WienerTensors {
         let device = Device::flex();
         let c = self.description.channels;
         let bins = self.spectra.len();
+        // Row-major, as `from_tensors` reads them.
         let part = |f: fn(&C64) -> f64| -> Vec<f32> {
             self.spectra
                 .iter()
@@ -583,7 +585,8 @@ impl WienerFilter {
                 })
                 .collect()
         };
-        let tensors = WienerTensors {
+        let noise: Vec<f32> = self.noise.transpose().iter().map(|&v| v as f32).collect();
+        WienerTensors {
             spectra_re: Param::from_tensor(Tensor::from_data(
                 TensorData::new(part(|v| v.re), [bins, c, c]),
                 &device,
@@ -592,18 +595,71 @@ impl WienerFilter {
                 TensorData::new(part(|v| v.im), [bins, c, c]),
                 &device,
             )),
-            noise: Param::from_tensor(Tensor::from_data(
-                TensorData::new(
-                    self.noise
-                        .transpose()
-                        .iter()
-                        .map(|&v| v as f32)
-                        .collect::<Vec<_>>(),
-                    [c, c],
-                ),
-                &device,
-            )),
+            noise: Param::from_tensor(Tensor::from_data(TensorData::new(noise, [c, c]), &device)),
+        }
+    }
+
+    /// Checks a stored description before anything is built from it.
+    pub(crate) fn check_description(
+        description: &WienerDescription,
+    ) -> std::result::Result<(), String> {
+        if description.segment < 8 || description.segment % 2 == 1 {
+            return Err(format!("bad Wiener filter segment {}", description.segment));
+        }
+        if description.channels == 0 || description.channels != 6 * description.joints.len() {
+            return Err(format!(
+                "bad Wiener filter description: {} channels for {} joints",
+                description.channels,
+                description.joints.len()
+            ));
+        }
+        if description.noise_sigma_deg.is_nan() || description.noise_sigma_deg <= 0.0 {
+            return Err("bad Wiener filter description: noise level".into());
+        }
+        Ok(())
+    }
+
+    /// Zeros of the shapes `description` stores, to load a file into.
+    pub(crate) fn empty_tensors(description: &WienerDescription) -> WienerTensors {
+        let device = Device::flex();
+        let (c, bins) = (description.channels, description.segment / 2 + 1);
+        WienerTensors {
+            spectra_re: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
+            spectra_im: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
+            noise: Param::from_tensor(Tensor::zeros([c, c], &device)),
+        }
+    }
+
+    /// The filter from loaded tensors (see [`WienerFilter::empty_tensors`]).
+    pub(crate) fn from_tensors(
+        description: WienerDescription,
+        tensors: WienerTensors,
+    ) -> std::result::Result<WienerFilter, String> {
+        let (c, bins) = (description.channels, description.segment / 2 + 1);
+        let read = |t: TensorData, what: &str| -> std::result::Result<Vec<f32>, String> {
+            t.try_to_vec::<f32>()
+                .map_err(|e| format!("reading the {what}: {e:?}"))
         };
+        let re = read(tensors.spectra_re.val().into_data(), "spectra")?;
+        let im = read(tensors.spectra_im.val().into_data(), "spectra")?;
+        let noise = read(tensors.noise.val().into_data(), "noise covariance")?;
+        if re.iter().chain(&im).chain(&noise).any(|v| !v.is_finite()) {
+            return Err("the Wiener filter holds non-finite numbers".into());
+        }
+        let spectra = (0..bins)
+            .map(|b| {
+                DMatrix::from_fn(c, c, |i, j| {
+                    let k = (b * c + i) * c + j;
+                    C64::new(re[k] as f64, im[k] as f64)
+                })
+            })
+            .collect();
+        let noise = DMatrix::from_fn(c, c, |i, j| noise[i * c + j] as f64);
+        Ok(Self::from_parts(description, spectra, noise))
+    }
+
+    /// Writes the filter (atomically) in the checkpoint format the networks use.
+    pub fn save(&self, path: &Path, data: serde_json::Value) -> Result<()> {
         let header = CheckpointHeader {
             kind: WIENER_KIND.into(),
             kind_version: WIENER_KIND_VERSION,
@@ -612,7 +668,7 @@ impl WienerFilter {
             data,
             training: serde_json::Value::Null,
         };
-        save_weights(path, &tensors, &header)?;
+        save_weights(path, &self.to_tensors(), &header)?;
         Ok(())
     }
 
@@ -635,46 +691,10 @@ impl WienerFilter {
         }
         let description: WienerDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad Wiener filter description: {e}")))?;
-        let c = description.channels;
-        if description.segment < 8 || description.segment % 2 == 1 || c == 0 {
-            return Err(bad(
-                "bad Wiener filter description: segment or channels".into()
-            ));
-        }
-        let bins = description.segment / 2 + 1;
-        let device = Device::flex();
-        let empty = WienerTensors {
-            spectra_re: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
-            spectra_im: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
-            noise: Param::from_tensor(Tensor::zeros([c, c], &device)),
-        };
+        Self::check_description(&description).map_err(bad)?;
+        let empty = Self::empty_tensors(&description);
         let tensors = load_weights_from_bytes(bytes, origin, empty)?;
-        let read = |t: Tensor<3>| -> Result<Vec<f32>> {
-            t.into_data()
-                .try_to_vec::<f32>()
-                .map_err(|e| bad(format!("reading the spectra: {e:?}")))
-        };
-        let re = read(tensors.spectra_re.val())?;
-        let im = read(tensors.spectra_im.val())?;
-        let noise: Vec<f32> = tensors
-            .noise
-            .val()
-            .into_data()
-            .try_to_vec::<f32>()
-            .map_err(|e| bad(format!("reading the noise covariance: {e:?}")))?;
-        if re.iter().chain(&im).chain(&noise).any(|v| !v.is_finite()) {
-            return Err(bad("the Wiener filter holds non-finite numbers".into()));
-        }
-        let spectra = (0..bins)
-            .map(|b| {
-                DMatrix::from_fn(c, c, |i, j| {
-                    let k = (b * c + i) * c + j;
-                    C64::new(re[k] as f64, im[k] as f64)
-                })
-            })
-            .collect();
-        let noise = DMatrix::from_fn(c, c, |i, j| noise[i * c + j] as f64);
-        Ok(Self::from_parts(description, spectra, noise))
+        Self::from_tensors(description, tensors).map_err(bad)
     }
 
     /// The same filter with every channel on its own: only the diagonals

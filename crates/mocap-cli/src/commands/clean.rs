@@ -89,6 +89,7 @@ struct TakeArgs {
 }
 
 #[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("base").args(["base_filter", "base_wiener"])))]
 struct TrainArgs {
     /// Folders or files of clean BVH takes (split by take into train / validation / test).
     #[arg(required = true)]
@@ -126,8 +127,12 @@ struct TrainArgs {
     /// With --base-filter: frames of the take the filter sees on each side of a training window;
     /// the trained model then filters whole takes at once (for `butterworth-gcv`, whose cutoff
     /// needs a long stretch to be chosen well). 0: each window alone.
-    #[arg(long, value_name = "FRAMES", requires = "base_filter")]
+    #[arg(long, value_name = "FRAMES", requires = "base")]
     base_context: Option<usize>,
+    /// A Wiener filter (from `mocap clean train --wiener`) whose output the network corrects, instead
+    /// of a classical --base-filter; the model file then holds both. Use with --base-context.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["base_filter", "spike_detector", "position_weight"])]
+    base_wiener: Option<PathBuf>,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -182,7 +187,8 @@ struct TrainArgs {
     #[arg(long, conflicts_with_all = [
         "spike_detector", "base_filter", "resume", "large", "epochs", "steps", "batch", "lr",
         "representation", "rotations", "position_weight", "width", "levels", "blocks", "window",
-        "max_sigma", "spike_probability", "max_spikes", "spike_sigma", "plot", "state",
+        "max_sigma", "spike_probability", "max_spikes", "spike_sigma", "plot", "state", "base_wiener",
+        "base_context",
     ])]
     wiener: bool,
     /// With --wiener: frames per Fourier segment (default 32).
@@ -341,6 +347,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.representation, a.representation);
     set(&mut o.frame, a.rotations);
     o.base_filter = a.base_filter;
+    o.base_wiener = a.base_wiener;
     set(&mut o.base_context, a.base_context);
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
