@@ -3,7 +3,9 @@
 # fitted to the training takes by `mocap clean train --wiener` (models/clean-wiener.safetensors, segment 32,
 # noise covariance at 5 degrees, seed 1), then the 116-take evaluation with the tuned filters, the shipped
 # network and it; and the study on 40 validation takes at fixed noise levels (wiener_bound example).
-# With --network [--resume]: a network trained on top of the Wiener filter, and its evaluation.
+# With --network [--resume]: a network trained on top of the Wiener filter (51 min here; shipped as
+# models/clean-default.safetensors since session 7), and its evaluation; with --despike: the shipped model and the
+# Wiener filter followed by spike finding.
 # Binaries: cargo build -p mocap-cli; CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
 cd "$(dirname "$0")/../.."
@@ -21,6 +23,14 @@ if [ "$1" == "--network" ]; then
     --model "Wiener filter (learned, multichannel)=models/clean-wiener.safetensors" \
     --model "network on the Wiener filter=$OUT/wiener-base.safetensors" \
     --json $OUT/eval-network.json --markdown $OUT/eval-network.md
+  exit 0
+fi
+if [ "$1" == "--despike" ]; then
+  # The shipped model (the network on the Wiener filter since session 7) and the Wiener filter, each also
+  # followed by spike finding (tuned per method on the validation takes).
+  $BIN/clean_eval --data $DATA --tune-takes 12 --despike --spike-lengths 2,4,8,16,32,64 \
+    --model "Wiener filter (learned, multichannel)=models/clean-wiener.safetensors" \
+    --json $OUT/eval-despike.json --markdown $OUT/eval-despike.md
   exit 0
 fi
 if [ "$1" != "--eval-only" ]; then

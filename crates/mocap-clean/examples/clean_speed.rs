@@ -1,7 +1,7 @@
 //! Inference and training speed of a denoiser (a benchmark, not a test).
 //!
 //! cargo run --release -p mocap-clean --example clean_speed -- --data ../shared/data/bandai \
-//!     [--model FILE] [--base-wiener FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
+//!     [--model FILE (a network or a Wiener filter)] [--base-wiener FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
 //!
 //! `--base-wiener`: the Wiener filter file a model on a Wiener base was trained with (its training
 //! speed needs it; the model file carries only what cleaning needs).
@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use mocap_clean::dataset::list_bvh;
-use mocap_clean::infer::CleanModel;
+use mocap_clean::infer::{CleanModel, ModelFile};
 use mocap_clean::training::{train, TrainOptions};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::Motion;
@@ -49,8 +49,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let data = data.ok_or("--data FOLDER is required")?;
     let model = match &model_path {
-        Some(p) => CleanModel::load(p, device)?,
-        None => CleanModel::load_default(device)?,
+        Some(p) => ModelFile::load(p, device)?,
+        None => ModelFile::Network(Box::new(CleanModel::load_default(device)?)),
     };
     // A long clip: takes joined end to end on the first take's skeleton.
     let paths = list_bvh(std::slice::from_ref(&data))?;
@@ -78,6 +78,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..repeats {
         model.clean(&clip, None)?;
     }
+    // A Wiener filter file: inference only (it is fitted, not trained).
+    let model = match model {
+        ModelFile::Network(model) => model,
+        ModelFile::Wiener(_) => {
+            let seconds = start.elapsed().as_secs_f64() / repeats as f64;
+            let fps = clip.frame_count() as f64 / seconds;
+            println!(
+                "inference (Wiener filter): {} frames in {:.4} s = {:.0} frames/s = {:.0}x real time at {:.0} fps",
+                clip.frame_count(),
+                seconds,
+                fps,
+                fps / clip.fps(),
+                clip.fps()
+            );
+            return Ok(());
+        }
+    };
     let seconds = start.elapsed().as_secs_f64() / repeats as f64;
     let fps = clip.frame_count() as f64 / seconds;
     println!(

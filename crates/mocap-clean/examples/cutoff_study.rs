@@ -11,7 +11,7 @@
 //!
 //! cargo run --profile test -p mocap-clean --example cutoff_study -- DATA [TAKES] [SIGMAS]
 
-use std::path::PathBuf;
+mod support;
 
 use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
 use mocap_clean::eval::rotation_error_deg;
@@ -27,15 +27,15 @@ const CUTOFFS: [f32; 13] = [
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let data = PathBuf::from(args.first().ok_or("DATA folder needed")?);
-    let max_takes: usize = args.get(1).map_or(Ok(40), |s| s.parse())?;
-    let sigmas: Vec<f32> = args
-        .get(2)
-        .map_or("0,1,2,4,6,8,10", String::as_str)
-        .split(',')
-        .map(str::parse)
-        .collect::<Result<_, _>>()?;
+    let support::StudyArgs {
+        data,
+        takes: max_takes,
+        sigmas,
+        rest,
+    } = support::parse()?;
+    if let Some(extra) = rest.first() {
+        return Err(format!("unexpected argument {extra:?} (DATA [TAKES] [SIGMAS])").into());
+    }
     let paths = paths_in_split(
         &list_bvh(&[data])?,
         Split::Validation,

@@ -4,37 +4,38 @@
 //!
 //! Fitted to the training takes (spectra of every take, noise covariance at
 //! 5 degrees), then for each sigma: mean rotation error of the input, of
-//! `butterworth-gcv:2`, of the Wiener filter with every channel on its own
+//! `butterworth-gcv:2`, of the same filter run in the eigenbasis of the
+//! noise covariance (channels whose noise is uncorrelated), of the Wiener filter with every channel on its own
 //! (true sigma), of the multichannel Wiener filter with the true sigma and
 //! with the sigma it estimates (marginal likelihood), and the mean
 //! estimated sigma.
 //!
 //! cargo run --profile test -p mocap-clean --example wiener_bound -- DATA [TAKES] [SIGMAS] [SEGMENT]
 
-use std::path::PathBuf;
+mod support;
+
 use std::time::Instant;
 
 use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
 use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::filters::{filter_motion, Filter};
+use mocap_clean::features::{FeatureLayout, Representation};
+use mocap_clean::filters::{filter_features, filter_motion, Filter};
 use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
 use mocap_clean::wiener::WienerFilter;
 use mocap_core::Motion;
+use nalgebra::{DMatrix, SymmetricEigen};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let data = PathBuf::from(args.first().ok_or("DATA folder needed")?);
-    let max_takes: usize = args.get(1).map_or(Ok(40), |s| s.parse())?;
-    let sigmas: Vec<f32> = args
-        .get(2)
-        .map_or("0,1,2,4,6,8,10", String::as_str)
-        .split(',')
-        .map(str::parse)
-        .collect::<Result<_, _>>()?;
-    let segment: usize = args.get(3).map_or(Ok(32), |s| s.parse())?;
+    let support::StudyArgs {
+        data,
+        takes: max_takes,
+        sigmas,
+        rest,
+    } = support::parse()?;
+    let segment: usize = rest.first().map_or(Ok(32), |s| s.parse())?;
     let all = list_bvh(&[data])?;
     let fractions = SplitFractions::default();
     let train = load_takes(&paths_in_split(&all, Split::Train, &fractions))?;
@@ -43,6 +44,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let train: Vec<&Motion> = train.iter().map(|t| &t.motion).collect();
     let wiener = WienerFilter::fit(&train, &RandomNoise::default(), 5.0, segment, 7)?;
     let per_channel = wiener.per_channel();
+    // The eigenvectors of the noise covariance: a basis in which the noise
+    // channels are uncorrelated, for GCV per channel in that basis.
+    let noise_basis = SymmetricEigen::new(wiener.noise_covariance().clone()).eigenvectors;
     let d = &wiener.description;
     println!(
         "fitted to {} training takes ({} frames, {} segments of {} frames; {} on other rigs left out) in {:.1} s",
@@ -63,16 +67,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "{} validation takes; mean rotation error (deg)",
         valid.len()
     );
-    println!("| sigma | input | butterworth-gcv:2 | Wiener per channel (true sigma) | multichannel Wiener (true sigma) | multichannel Wiener (estimated sigma) | mean estimated sigma |");
-    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!("| sigma | input | butterworth-gcv:2 | the same in the noise's eigenbasis | Wiener per channel (true sigma) | multichannel Wiener (true sigma) | multichannel Wiener (estimated sigma) | mean estimated sigma |");
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for &sigma in &sigmas {
-        let rows: Vec<[f64; 6]> = valid
+        let rows: Vec<[f64; 7]> = valid
             .par_iter()
             .enumerate()
             .map(|(i, clean)| {
                 let mut rng = ChaCha8Rng::seed_from_u64(1000 + i as u64);
                 let noisy = add_random_noise_sigma(clean, sigma, &RandomNoise::default(), &mut rng);
                 let gcv = filter_motion(&noisy, &Filter::ButterworthGcv { order: 2 }).unwrap();
+                let rotated = gcv_in_basis(&noisy, &noise_basis);
                 let truth = Some(sigma as f64);
                 let (diagonal, _) = per_channel.clean(&noisy, truth).unwrap();
                 let (oracle, _) = wiener.clean(&noisy, truth).unwrap();
@@ -80,6 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 [
                     rotation_error_deg(clean, &noisy),
                     rotation_error_deg(clean, &gcv),
+                    rotation_error_deg(clean, &rotated),
                     rotation_error_deg(clean, &diagonal),
                     rotation_error_deg(clean, &oracle),
                     rotation_error_deg(clean, &estimated),
@@ -89,10 +95,46 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         let n = rows.len() as f64;
         print!("| {sigma} |");
-        for k in 0..6 {
+        for k in 0..7 {
             print!(" {:.3} |", rows.iter().map(|r| r[k]).sum::<f64>() / n);
         }
         println!();
     }
     Ok(())
+}
+
+/// `butterworth-gcv:2` run on the features turned into `basis` (columns):
+/// `U filter(U^T x)`.
+fn gcv_in_basis(noisy: &Motion, basis: &DMatrix<f64>) -> Motion {
+    let layout = FeatureLayout::new(noisy.skeleton(), Representation::Rot6d).unwrap();
+    let c = layout.channels();
+    let x = layout.encode(noisy);
+    let turn = |v: &[f32], transpose: bool| -> Vec<f32> {
+        v.chunks_exact(c)
+            .flat_map(|frame| {
+                (0..c).map(move |k| {
+                    (0..c)
+                        .map(|r| {
+                            let u = if transpose {
+                                basis[(r, k)]
+                            } else {
+                                basis[(k, r)]
+                            };
+                            u * frame[r] as f64
+                        })
+                        .sum::<f64>() as f32
+                })
+            })
+            .collect()
+    };
+    let mut y = turn(&x, true);
+    filter_features(
+        &mut y,
+        c,
+        &Filter::ButterworthGcv { order: 2 },
+        noisy.fps() as f32,
+    );
+    let mut out = noisy.clone();
+    layout.decode_into(&turn(&y, false), &mut out);
+    out
 }

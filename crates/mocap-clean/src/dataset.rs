@@ -157,6 +157,29 @@ pub struct DataDescription {
     pub held_out: Vec<String>,
 }
 
+impl DataDescription {
+    /// The description of data `inputs` listing `paths`, split by `split`:
+    /// the test and held-out takes filled in, the training and validation
+    /// counts zero (the caller knows what it loaded).
+    pub fn new(inputs: &[PathBuf], paths: &[PathBuf], split: SplitFractions, fps: f64) -> Self {
+        DataDescription {
+            inputs: inputs.iter().map(|p| p.display().to_string()).collect(),
+            split,
+            train_takes: 0,
+            train_frames: 0,
+            validation_takes: 0,
+            validation_frames: 0,
+            test_takes: paths_in_split(paths, Split::Test, &split).len(),
+            fps,
+            held_out: paths
+                .iter()
+                .map(|p| take_name(p))
+                .filter(|n| split_of(n, &split) != Split::Train)
+                .collect(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

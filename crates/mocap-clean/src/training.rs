@@ -31,8 +31,8 @@ use rand::{Rng, RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{
-    list_bvh, load_takes, looped_window, paths_in_split, split_of, take_name, window,
-    DataDescription, Split, SplitFractions, Take,
+    list_bvh, load_takes, looped_window, paths_in_split, window, DataDescription, Split,
+    SplitFractions, Take,
 };
 use crate::features::{FeatureLayout, Recentering, Representation, RotationFrame};
 use crate::filters::{filter_features, Filter};
@@ -634,25 +634,12 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             fps,
         }
     };
-    let held_out = paths
-        .iter()
-        .map(|p| take_name(p))
-        .filter(|n| split_of(n, &options.split) != Split::Train)
-        .collect();
     let data = DataDescription {
-        inputs: options
-            .inputs
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect(),
-        split: options.split,
         train_takes: train_takes.len(),
         train_frames: train_takes.iter().map(|t| t.motion.frame_count()).sum(),
         validation_takes: valid_takes.len(),
         validation_frames: valid_takes.iter().map(|t| t.motion.frame_count()).sum(),
-        test_takes: paths_in_split(&paths, Split::Test, &options.split).len(),
-        fps: fps as f64,
-        held_out,
+        ..DataDescription::new(&options.inputs, &paths, options.split, fps as f64)
     };
 
     if options.position_weight > 0.0 && options.base_filter.is_some() {

@@ -70,8 +70,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{
-    list_bvh, load_takes, paths_in_split, split_of, take_name, DataDescription, Split,
-    SplitFractions,
+    list_bvh, load_takes, paths_in_split, DataDescription, Split, SplitFractions,
 };
 use crate::features::{FeatureLayout, Representation};
 use crate::noise::{add_random_noise_sigma, RandomNoise};
@@ -697,6 +696,12 @@ impl WienerFilter {
         Self::from_tensors(description, tensors).map_err(bad)
     }
 
+    /// `N`, the per-frame covariance of the noise of the features at
+    /// [`WienerDescription::noise_sigma_deg`].
+    pub fn noise_covariance(&self) -> &DMatrix<f64> {
+        &self.noise
+    }
+
     /// The same filter with every channel on its own: only the diagonals
     /// of the spectra and of `N` kept (what a per-channel filter can know;
     /// for comparisons).
@@ -775,25 +780,16 @@ pub fn fit_files(options: &WienerFitOptions) -> Result<WienerFitReport> {
         options.segment,
         options.seed,
     )?;
-    let valid_paths = paths_in_split(&paths, Split::Validation, &options.split);
     let data = DataDescription {
-        inputs: options
-            .inputs
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect(),
-        split: options.split,
         train_takes: filter.description.takes,
         train_frames: filter.description.frames,
-        validation_takes: valid_paths.len(),
-        validation_frames: 0,
-        test_takes: paths_in_split(&paths, Split::Test, &options.split).len(),
-        fps: filter.description.fps as f64,
-        held_out: paths
-            .iter()
-            .map(|p| take_name(p))
-            .filter(|n| split_of(n, &options.split) != Split::Train)
-            .collect(),
+        validation_takes: paths_in_split(&paths, Split::Validation, &options.split).len(),
+        ..DataDescription::new(
+            &options.inputs,
+            &paths,
+            options.split,
+            filter.description.fps as f64,
+        )
     };
     let data_json = serde_json::to_value(&data)
         .map_err(|e| CleanError::Invalid(format!("describing the data: {e}")))?;

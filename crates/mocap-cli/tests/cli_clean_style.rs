@@ -190,19 +190,25 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     assert!(!never.exists());
 }
 
+/// Forty real dataset-2 takes copied into `dir/takes` (the 10% validation
+/// split by take gets several).
+fn forty_takes(dir: &Path, data: &Path) -> PathBuf {
+    let takes = dir.join("takes");
+    std::fs::create_dir(&takes).unwrap();
+    let files: Vec<PathBuf> = mocap_testdata::bvh_files(&data.join("bandai/dataset-2"));
+    for file in files.iter().step_by(files.len() / 40).take(40) {
+        std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
+    }
+    takes
+}
+
 #[test]
 fn clean_train_writes_a_model_that_clean_can_use() {
     let Some(data) = mocap_testdata::shared_data() else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    // Forty real takes: the 10% validation split by take gets several.
-    let takes = dir.path().join("takes");
-    std::fs::create_dir(&takes).unwrap();
-    let files: Vec<PathBuf> = mocap_testdata::bvh_files(&data.join("bandai/dataset-2"));
-    for file in files.iter().step_by(files.len() / 40).take(40) {
-        std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
-    }
+    let takes = forty_takes(dir.path(), &data);
     // A tiny network, a few steps, the report on stdout; `extra` adds options.
     let train = |model: &Path, extra: &[&str]| {
         let mut args = vec!["clean", "train", path(&takes), "-o", path(model)];
@@ -270,12 +276,7 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let takes = dir.path().join("takes");
-    std::fs::create_dir(&takes).unwrap();
-    let files: Vec<PathBuf> = mocap_testdata::bvh_files(&data.join("bandai/dataset-2"));
-    for file in files.iter().step_by(files.len() / 40).take(40) {
-        std::fs::copy(file, takes.join(file.file_name().unwrap())).unwrap();
-    }
+    let takes = forty_takes(dir.path(), &data);
     let filter = dir.path().join("wiener.safetensors");
     let out = mocap(&[
         "clean",
