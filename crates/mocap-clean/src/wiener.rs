@@ -44,8 +44,11 @@
 //! ```
 //!
 //! (half weight at the real frequencies 0 and Nyquist), maximised over a
-//! grid of `sigma`. A clean take gets a `sigma` near 0 and is nearly left
-//! alone.
+//! grid of `sigma`. Only the segments inside the take count (the mirrored
+//! padding bends the channels at its ends) and only the directions the
+//! noise model puts noise in (elsewhere any power the training spectra did
+//! not foresee would be taken for noise). A clean take gets a `sigma` near 0
+//! and is nearly left alone.
 //!
 //! ## Limits
 //!
@@ -131,10 +134,10 @@ struct Bin {
     /// Eigenvalues of the whitened signal spectrum (>= 0).
     lambda: Vec<f64>,
     /// The same decomposition restricted to the directions the noise model
-    /// puts noise in (no ridge), for judging the noise level (2):
+    /// puts noise in (no ridge), for estimating the noise level (2):
     /// `V'^H D^-1/2 Q^T` with `N = Q D Q^T` over those directions.
-    judge: DMatrix<C64>,
-    judge_lambda: Vec<f64>,
+    noisy_to_white: DMatrix<C64>,
+    noisy_lambda: Vec<f64>,
 }
 
 /// A fitted filter (see the module docs).
@@ -364,7 +367,7 @@ impl WienerFilter {
             (&eigen.eigenvectors * d * eigen.eigenvectors.transpose()).map(|v| C64::new(v, 0.0))
         };
         let (half, inverse_half) = (root(0.5), root(-0.5));
-        // The noise level is judged only in the directions the noise model
+        // The noise level is estimated only in the directions the noise model
         // puts noise in: in the others the whitening has nothing but the
         // ridge to divide by, and any power the training spectra did not
         // foresee there would be taken for noise.
@@ -373,7 +376,7 @@ impl WienerFilter {
         let noisy: Vec<usize> = (0..c)
             .filter(|&i| noise_eigen.eigenvalues[i] > 1e-6 * largest && largest > 0.0)
             .collect();
-        let judge_basis = DMatrix::from_fn(noisy.len(), c, |k, j| {
+        let noisy_whitening = DMatrix::from_fn(noisy.len(), c, |k, j| {
             let i = noisy[k];
             C64::new(
                 noise_eigen.eigenvectors[(j, i)] / noise_eigen.eigenvalues[i].sqrt(),
@@ -388,13 +391,17 @@ impl WienerFilter {
             .par_iter()
             .map(|s| {
                 let eigen = hermitian_eigen(&inverse_half * s * &inverse_half);
-                let judged = hermitian_eigen(&judge_basis * s * judge_basis.adjoint());
+                let noisy_white = hermitian_eigen(&noisy_whitening * s * noisy_whitening.adjoint());
                 Bin {
                     to_white: eigen.eigenvectors.adjoint() * &inverse_half,
                     from_white: &half * &eigen.eigenvectors,
                     lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
-                    judge: judged.eigenvectors.adjoint() * &judge_basis,
-                    judge_lambda: judged.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                    noisy_to_white: noisy_white.eigenvectors.adjoint() * &noisy_whitening,
+                    noisy_lambda: noisy_white
+                        .eigenvalues
+                        .iter()
+                        .map(|&l| l.max(0.0))
+                        .collect(),
                 }
             })
             .collect();
@@ -447,8 +454,13 @@ impl WienerFilter {
     pub fn filter_features(&self, features: &mut [f32], sigma_deg: Option<f64>) -> WienerOutcome {
         let c = self.description.channels;
         let len = self.description.segment;
+        let frames = features.len() / c;
+        if frames == 0 {
+            return WienerOutcome {
+                sigma_deg: sigma_deg.unwrap_or(0.0),
+            };
+        }
         let (x, mean) = centred(features, c);
-        let frames = x.len() / c;
         let padded = reflect_pad(&x, c, len);
         let total = padded.len() / c;
         let window: Vec<f64> = (0..len).map(|t| hann(t, len).sqrt()).collect();
@@ -458,7 +470,7 @@ impl WienerFilter {
             .collect();
         // Whitened coefficients z = V^H N^-1/2 X of every segment and bin,
         // and those of the noisy directions (for judging the noise level).
-        let (white, judged): (Vec<SegmentCoefficients>, Vec<SegmentCoefficients>) = starts
+        let (white, noisy_white): (Vec<SegmentCoefficients>, Vec<SegmentCoefficients>) = starts
             .par_iter()
             .map(|&s| {
                 let spectrum = segment_spectrum(&padded, c, s, len, &window);
@@ -468,25 +480,25 @@ impl WienerFilter {
                     .map(|(b, bin)| {
                         (
                             &bin.to_white * spectrum.column(b),
-                            &bin.judge * spectrum.column(b),
+                            &bin.noisy_to_white * spectrum.column(b),
                         )
                     })
                     .unzip()
             })
             .unzip();
-        // The noise level is judged on the segments inside the take: the
+        // The noise level is estimated on the segments inside the take: the
         // mirrored padding bends every channel at the take's ends, power
         // the clean spectra never had (all segments when the take is
         // shorter than one).
         let inside: Vec<&SegmentCoefficients> = starts
             .iter()
-            .zip(&judged)
+            .zip(&noisy_white)
             .filter(|(&s, _)| s >= len && s + len <= len + frames)
             .map(|(_, z)| z)
             .collect();
         let sigma = sigma_deg.unwrap_or_else(|| {
             if inside.is_empty() {
-                self.estimate_sigma_deg(&judged.iter().collect::<Vec<_>>(), &window)
+                self.estimate_sigma_deg(&noisy_white.iter().collect::<Vec<_>>(), &window)
             } else {
                 self.estimate_sigma_deg(&inside, &window)
             }
@@ -525,8 +537,8 @@ impl WienerFilter {
     }
 
     /// The noise level of largest marginal likelihood (2), from the
-    /// coefficients of the noisy directions (`Bin::judge`) of segments.
-    fn estimate_sigma_deg(&self, judged: &[&SegmentCoefficients], window: &[f64]) -> f64 {
+    /// coefficients of the noisy directions (`Bin::noisy_to_white`) of segments.
+    fn estimate_sigma_deg(&self, noisy_white: &[&SegmentCoefficients], window: &[f64]) -> f64 {
         // Coefficients of a window v have variance (lambda + s) sum(v^2)
         // in the units the spectra were normalised to.
         let norm: f64 = window.iter().map(|v| v * v).sum();
@@ -535,22 +547,22 @@ impl WienerFilter {
         let mut power: Vec<Vec<f64>> = self
             .bins
             .iter()
-            .map(|bin| vec![0.0; bin.judge_lambda.len()])
+            .map(|bin| vec![0.0; bin.noisy_lambda.len()])
             .collect();
-        for z in judged {
+        for z in noisy_white {
             for (p, zb) in power.iter_mut().zip(z.iter()) {
                 for (pi, v) in p.iter_mut().zip(zb.iter()) {
                     *pi += v.norm_sqr() / norm;
                 }
             }
         }
-        let n = judged.len() as f64;
+        let n = noisy_white.len() as f64;
         let log_likelihood = |s: f64| -> f64 {
             let mut total = 0.0;
             for (b, (bin, p)) in self.bins.iter().zip(&power).enumerate() {
                 let weight = if b == 0 || 2 * b == len { 0.5 } else { 1.0 };
                 let mut sum = 0.0;
-                for (&l, &pi) in bin.judge_lambda.iter().zip(p) {
+                for (&l, &pi) in bin.noisy_lambda.iter().zip(p) {
                     let v = l + s;
                     sum += -n * v.ln() - pi / v;
                 }
@@ -836,8 +848,8 @@ mod tests {
                 to_white: DMatrix::identity(c, c),
                 from_white: DMatrix::identity(c, c),
                 lambda: vec![1e30; c],
-                judge: DMatrix::identity(c, c),
-                judge_lambda: vec![1e30; c],
+                noisy_to_white: DMatrix::identity(c, c),
+                noisy_lambda: vec![1e30; c],
             })
             .collect();
         let filter = WienerFilter {
@@ -857,7 +869,7 @@ mod tests {
             noise: DMatrix::zeros(c, c),
             bins,
         };
-        for frames in [1, 5, 31, 32, 33, 100] {
+        for frames in [0, 1, 5, 31, 32, 33, 100] {
             let x: Vec<f32> = (0..frames * c)
                 .map(|i| ((i * 37 % 101) as f32 / 50.0 - 1.0) + (i / c) as f32 * 0.01)
                 .collect();
