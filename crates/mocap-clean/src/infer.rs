@@ -160,6 +160,17 @@ impl CleanModel {
 
     /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
+        Ok(self.clean_reporting(motion, hop)?.0)
+    }
+
+    /// [`CleanModel::clean`], also returning the noise level (degrees) its
+    /// Wiener filter estimated for the take, when it corrects one
+    /// ([`ModelDescription::base_wiener`]) and that filter sees the whole take.
+    pub fn clean_reporting(
+        &self,
+        motion: &Motion,
+        hop: Option<usize>,
+    ) -> Result<(Motion, Option<f64>)> {
         if self.description.network.head != Head::Correction {
             return Err(CleanError::Invalid(format!(
                 "{} is a spike detector (`mocap clean train --spike-detector`), not a denoiser: \
@@ -173,7 +184,7 @@ impl CleanModel {
         let hop = hop.unwrap_or(t / 4).clamp(1, t);
         let frames = motion.frame_count();
         if frames == 0 {
-            return Ok(motion.clone());
+            return Ok((motion.clone(), None));
         }
         let features = layout.encode(motion);
         // A base filter that sees the whole take runs once, before the take
@@ -183,10 +194,11 @@ impl CleanModel {
             (None, Some(wiener)) => Some(Base::Wiener(wiener)),
             (None, None) => None,
         };
+        let mut noise_deg = None;
         let filtered_take = match &base {
             Some(base) if self.description.base_context > 0 => {
                 let mut filtered = features.clone();
-                base.apply(&mut filtered, c);
+                noise_deg = base.apply(&mut filtered, c);
                 Some(filtered)
             }
             _ => None,
@@ -288,7 +300,7 @@ impl CleanModel {
         }
         let mut out = motion.clone();
         layout.decode_into(&cleaned, &mut out);
-        Ok(out)
+        Ok((out, noise_deg))
     }
 
     /// The learned filter the network corrects, if it corrects one
@@ -348,7 +360,10 @@ impl ModelFile {
     /// ran, e.g. `Wiener filter (sigma 4.2 deg)`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<(Motion, String)> {
         match self {
-            ModelFile::Network(model) => Ok((model.clean(motion, hop)?, "model".into())),
+            ModelFile::Network(model) => {
+                let (out, noise) = model.clean_reporting(motion, hop)?;
+                Ok((out, model_label(noise)))
+            }
             ModelFile::Wiener(filter) => {
                 let (out, outcome) = filter.clean(motion, None)?;
                 Ok((
@@ -360,6 +375,15 @@ impl ModelFile {
                 ))
             }
         }
+    }
+}
+
+/// How a network's cleaning is described: with the noise level its Wiener
+/// filter estimated, when it has one.
+fn model_label(noise_deg: Option<f64>) -> String {
+    match noise_deg {
+        Some(sigma) => format!("model (noise estimated at {sigma:.1} deg)"),
+        None => "model".into(),
     }
 }
 
@@ -464,10 +488,12 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         Method::DefaultModel => {
             let model = CleanModel::load_default(options.device)?;
             let start = Instant::now();
-            let out = model.clean(&motion, options.hop).map_err(in_file)?;
+            let (out, noise) = model
+                .clean_reporting(&motion, options.hop)
+                .map_err(in_file)?;
             (
                 out,
-                format!("model {}", model.source.display()),
+                format!("{} {}", model_label(noise), model.source.display()),
                 start.elapsed().as_secs_f64(),
             )
         }
@@ -567,6 +593,13 @@ mod tests {
                 .unwrap()
         };
         let with_context = cleaned_by(&description);
+        // A classical base estimates no noise level.
+        let bytes = description_bytes(&model, &description);
+        let (_, noise) = CleanModel::from_bytes(bytes, Path::new("t"), DeviceChoice::Cpu)
+            .unwrap()
+            .clean_reporting(&noisy, None)
+            .unwrap();
+        assert_eq!(noise, None);
         let off = crate::eval::rotation_error_deg(&whole_take, &with_context);
         assert!(off < 1e-3, "{off} degrees from the whole-take filter");
         for f in 0..noisy.frame_count() {

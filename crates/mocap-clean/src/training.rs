@@ -106,13 +106,15 @@ pub(crate) enum Base<'a> {
 }
 
 impl Base<'_> {
-    /// Filters `features` (frames x `channels`) in place.
-    pub(crate) fn apply(&self, features: &mut [f32], channels: usize) {
+    /// Filters `features` (frames x `channels`) in place; a Wiener filter
+    /// also says the noise level it estimated (degrees).
+    pub(crate) fn apply(&self, features: &mut [f32], channels: usize) -> Option<f64> {
         match self {
-            Base::Classical(filter, fps) => filter_features(features, channels, filter, *fps),
-            Base::Wiener(wiener) => {
-                wiener.filter_features(features, None);
+            Base::Classical(filter, fps) => {
+                filter_features(features, channels, filter, *fps);
+                None
             }
+            Base::Wiener(wiener) => Some(wiener.filter_features(features, None).sigma_deg),
         }
     }
 }
@@ -1155,8 +1157,11 @@ mod tests {
             &crate::noise::RandomNoise::default(),
             &mut rng,
         );
-        let trained = model.clean(&noisy, None).unwrap();
+        let (trained, noise) = model.clean_reporting(&noisy, None).unwrap();
         assert!(trained.values().iter().all(|v| v.is_finite()));
+        // It says the noise level its filter found (4 degrees were added).
+        let noise = noise.expect("a Wiener filter estimates the noise");
+        assert!((1.0..16.0).contains(&noise), "{noise}");
         // With no correction the model is its Wiener filter over the take.
         model.zero_output();
         let zeroed = model.clean(&noisy, None).unwrap();
