@@ -58,6 +58,7 @@
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use burn::module::{Module, Param};
@@ -70,6 +71,7 @@ use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;
+use rustfft::{Fft, FftPlanner};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{
@@ -196,44 +198,64 @@ fn reflect_pad(x: &[f64], c: usize, pad: usize) -> Vec<f64> {
     out
 }
 
-/// The discrete Fourier transform along time, bins `0..=len/2`, of each
-/// channel of the `len` frames from `start`, multiplied by `window`: a
-/// `c x (len/2 + 1)` matrix.
-fn segment_spectrum(x: &[f64], c: usize, start: usize, len: usize, window: &[f64]) -> DMatrix<C64> {
-    let bins = len / 2 + 1;
-    let mut out = DMatrix::<C64>::zeros(c, bins);
-    for (t, &w) in window.iter().enumerate() {
-        let frame = &x[(start + t) * c..(start + t + 1) * c];
-        for b in 0..bins {
-            let angle = -2.0 * PI * ((b * t) % len) as f64 / len as f64;
-            let e = C64::new(angle.cos(), angle.sin()) * w;
-            let mut column = out.column_mut(b);
-            for (o, &v) in column.iter_mut().zip(frame) {
-                *o += e * v;
-            }
-        }
-    }
-    out
+/// Forward and inverse Fourier transforms of one segment length
+/// (`rustfft` plans, made once per fit or per take).
+struct Transforms {
+    forward: Arc<dyn Fft<f64>>,
+    inverse: Arc<dyn Fft<f64>>,
+    len: usize,
 }
 
-/// The real frames of a segment from its bins `0..=len/2` (the other bins
-/// are their conjugates): `len x c`, frame-major.
-fn inverse_segment(spectrum: &DMatrix<C64>, len: usize) -> Vec<f64> {
-    let c = spectrum.nrows();
-    let bins = spectrum.ncols();
-    let mut out = vec![0.0; len * c];
-    for t in 0..len {
-        let frame = &mut out[t * c..(t + 1) * c];
-        for b in 0..bins {
-            let angle = 2.0 * PI * ((b * t) % len) as f64 / len as f64;
-            let e = C64::new(angle.cos(), angle.sin());
-            let scale = if b == 0 || 2 * b == len { 1.0 } else { 2.0 } / len as f64;
-            for (o, &v) in frame.iter_mut().zip(spectrum.column(b).iter()) {
-                *o += scale * (v * e).re;
-            }
+impl Transforms {
+    fn new(len: usize) -> Transforms {
+        let mut planner = FftPlanner::new();
+        Transforms {
+            forward: planner.plan_fft_forward(len),
+            inverse: planner.plan_fft_inverse(len),
+            len,
         }
     }
-    out
+
+    /// The discrete Fourier transform along time, bins `0..=len/2`, of
+    /// each channel of the `len` frames from `start`, multiplied by
+    /// `window`: a `c x (len/2 + 1)` matrix.
+    fn segment_spectrum(&self, x: &[f64], c: usize, start: usize, window: &[f64]) -> DMatrix<C64> {
+        let (len, bins) = (self.len, self.len / 2 + 1);
+        let mut out = DMatrix::<C64>::zeros(c, bins);
+        let mut buffer = vec![C64::new(0.0, 0.0); len];
+        for k in 0..c {
+            for (t, (b, &w)) in buffer.iter_mut().zip(window).enumerate() {
+                *b = C64::new(w * x[(start + t) * c + k], 0.0);
+            }
+            self.forward.process(&mut buffer);
+            for b in 0..bins {
+                out[(k, b)] = buffer[b];
+            }
+        }
+        out
+    }
+
+    /// The real frames of a segment from its bins `0..=len/2` (the others
+    /// are their conjugates): `len x c`, frame-major.
+    fn inverse_segment(&self, spectrum: &DMatrix<C64>) -> Vec<f64> {
+        let (len, c) = (self.len, spectrum.nrows());
+        let mut out = vec![0.0; len * c];
+        let mut buffer = vec![C64::new(0.0, 0.0); len];
+        for k in 0..c {
+            for b in 0..len {
+                buffer[b] = if b <= len / 2 {
+                    spectrum[(k, b)]
+                } else {
+                    spectrum[(k, len - b)].conj()
+                };
+            }
+            self.inverse.process(&mut buffer);
+            for (t, v) in buffer.iter().enumerate() {
+                out[t * c + k] = v.re / len as f64;
+            }
+        }
+        out
+    }
 }
 
 impl WienerFilter {
@@ -270,6 +292,7 @@ impl WienerFilter {
         let bins = segment / 2 + 1;
         let window: Vec<f64> = (0..segment).map(|t| hann(t, segment)).collect();
         let window_power: f64 = window.iter().map(|w| w * w).sum();
+        let transforms = Transforms::new(segment);
         // Welch: the mean of X X^H over half-overlapping Hann segments.
         let per_take: Vec<(Vec<DMatrix<C64>>, usize)> = same_rig
             .par_iter()
@@ -280,7 +303,7 @@ impl WienerFilter {
                 let mut count = 0;
                 let mut start = 0;
                 while start + segment <= frames {
-                    let spectrum = segment_spectrum(&x, c, start, segment, &window);
+                    let spectrum = transforms.segment_spectrum(&x, c, start, &window);
                     for (b, sum) in sums.iter_mut().enumerate() {
                         let column = spectrum.column(b);
                         sum.ger(
@@ -464,6 +487,7 @@ impl WienerFilter {
         let padded = reflect_pad(&x, c, len);
         let total = padded.len() / c;
         let window: Vec<f64> = (0..len).map(|t| hann(t, len).sqrt()).collect();
+        let transforms = Transforms::new(len);
         let starts: Vec<usize> = (0..)
             .map(|k| k * len / 2)
             .take_while(|s| s + len <= total)
@@ -473,7 +497,7 @@ impl WienerFilter {
         let (white, noisy_white): (Vec<SegmentCoefficients>, Vec<SegmentCoefficients>) = starts
             .par_iter()
             .map(|&s| {
-                let spectrum = segment_spectrum(&padded, c, s, len, &window);
+                let spectrum = transforms.segment_spectrum(&padded, c, s, &window);
                 self.bins
                     .iter()
                     .enumerate()
@@ -517,7 +541,7 @@ impl WienerFilter {
                     );
                     spectrum.set_column(b, &(&bin.from_white * gained));
                 }
-                inverse_segment(&spectrum, len)
+                transforms.inverse_segment(&spectrum)
             })
             .collect();
         // Overlap-add with the synthesis window (analysis x synthesis = Hann).
