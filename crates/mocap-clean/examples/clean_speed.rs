@@ -78,34 +78,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..repeats {
         model.clean(&clip, None)?;
     }
-    // A Wiener filter file: inference only (it is fitted, not trained).
-    let model = match model {
-        ModelFile::Network(model) => model,
-        ModelFile::Wiener(_) => {
-            let seconds = start.elapsed().as_secs_f64() / repeats as f64;
-            let fps = clip.frame_count() as f64 / seconds;
-            println!(
-                "inference (Wiener filter): {} frames in {:.4} s = {:.0} frames/s = {:.0}x real time at {:.0} fps",
-                clip.frame_count(),
-                seconds,
-                fps,
-                fps / clip.fps(),
-                clip.fps()
-            );
-            return Ok(());
-        }
-    };
     let seconds = start.elapsed().as_secs_f64() / repeats as f64;
     let fps = clip.frame_count() as f64 / seconds;
+    let what = match &model {
+        ModelFile::Network(m) => format!("{} parameters, device {device}", m.parameter_count()),
+        ModelFile::Wiener(_) => "Wiener filter".into(),
+    };
     println!(
-        "inference: {} frames in {:.4} s = {:.0} frames/s = {:.0}x real time at {:.0} fps ({} parameters, device {device})",
+        "inference: {} frames in {:.4} s = {:.0} frames/s = {:.0}x real time at {:.0} fps ({what})",
         clip.frame_count(),
         seconds,
         fps,
         fps / clip.fps(),
         clip.fps(),
-        model.parameter_count()
     );
+    // A Wiener filter is fitted, not trained: no training speed.
+    let ModelFile::Network(model) = model else {
+        return Ok(());
+    };
     if train_steps > 0 && model.description.base_wiener.is_some() && base_wiener.is_none() {
         return Err(
             "the model corrects a Wiener filter: give its file with --base-wiener to time training"
