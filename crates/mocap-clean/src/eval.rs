@@ -42,7 +42,6 @@ use crate::filters::{filter_motion, Filter};
 use crate::infer::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
 use crate::spikes::{SpikeDetector, SpikeOptions};
-use crate::wiener::WienerFilter;
 use crate::{CleanError, Result};
 
 /// Mean geodesic angle (degrees) between the local rotations of two
@@ -308,8 +307,8 @@ fn tune_despike(
 #[derive(Clone)]
 enum Cleaner {
     Filter(Filter),
-    Model(Rc<CleanModel>),
-    Wiener(Rc<WienerFilter>),
+    /// A network or a Wiener filter.
+    Model(Rc<ModelFile>),
     Spikes(Rc<SpikeDetector>),
     /// The first, then the second on its output.
     Then(Box<Cleaner>, Box<Cleaner>),
@@ -319,8 +318,7 @@ impl Cleaner {
     fn run(&self, noisy: &Motion) -> Result<Motion> {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
-            Cleaner::Model(m) => m.clean(noisy, None),
-            Cleaner::Wiener(w) => Ok(w.clean(noisy, None)?.0),
+            Cleaner::Model(m) => Ok(m.clean(noisy, None)?.0),
             Cleaner::Spikes(d) => Ok(d.remove_spikes(noisy, &SpikeOptions::default())?.0),
             Cleaner::Then(first, second) => second.run(&first.run(noisy)?),
         }
@@ -447,14 +445,11 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     let takes = load_takes(&eval_paths)?;
     let mut models = Vec::new();
     for m in &options.models {
-        let cleaner = match &m.path {
-            Some(p) => match ModelFile::load(p, options.device)? {
-                ModelFile::Network(model) => Cleaner::Model(Rc::from(model)),
-                ModelFile::Wiener(filter) => Cleaner::Wiener(Rc::new(filter)),
-            },
-            None => Cleaner::Model(Rc::new(CleanModel::load_default(options.device)?)),
+        let model = match &m.path {
+            Some(p) => ModelFile::load(p, options.device)?,
+            None => ModelFile::Network(Box::new(CleanModel::load_default(options.device)?)),
         };
-        models.push((m.label.clone(), cleaner));
+        models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
     }
     let detector = match &options.spike_detector {
         Some(entry) => Some((

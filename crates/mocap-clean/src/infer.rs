@@ -189,11 +189,11 @@ impl CleanModel {
         let features = layout.encode(motion);
         // A base filter that sees the whole take runs once, before the take
         // is cut into windows (see `ModelDescription::base_context`).
-        let base = match (&self.description.base_filter, &self.base_wiener) {
-            (Some(filter), _) => Some(Base::Classical(*filter, self.description.fps)),
-            (None, Some(wiener)) => Some(Base::Wiener(wiener)),
-            (None, None) => None,
-        };
+        let base = Base::of(
+            self.description.base_filter,
+            self.description.fps,
+            self.base_wiener.as_ref(),
+        );
         let mut noise_deg = None;
         let filtered_take = match &base {
             Some(base) if self.description.base_context > 0 => {
@@ -362,7 +362,11 @@ impl ModelFile {
         match self {
             ModelFile::Network(model) => {
                 let (out, noise) = model.clean_reporting(motion, hop)?;
-                Ok((out, model_label(noise)))
+                let label = match noise {
+                    Some(sigma) => format!("model (noise estimated at {sigma:.1} deg)"),
+                    None => "model".into(),
+                };
+                Ok((out, label))
             }
             ModelFile::Wiener(filter) => {
                 let (out, outcome) = filter.clean(motion, None)?;
@@ -375,15 +379,6 @@ impl ModelFile {
                 ))
             }
         }
-    }
-}
-
-/// How a network's cleaning is described: with the noise level its Wiener
-/// filter estimated, when it has one.
-fn model_label(noise_deg: Option<f64>) -> String {
-    match noise_deg {
-        Some(sigma) => format!("model (noise estimated at {sigma:.1} deg)"),
-        None => "model".into(),
     }
 }
 
@@ -475,25 +470,20 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             let out = filter_motion(&motion, filter)?;
             (out, filter.label(), start.elapsed().as_secs_f64())
         }
-        Method::Model(path) => {
-            let model = ModelFile::load(path, options.device)?;
+        Method::Model(_) | Method::DefaultModel => {
+            let (model, source) = match &options.method {
+                Method::Model(path) => (ModelFile::load(path, options.device)?, path.clone()),
+                _ => {
+                    let model = CleanModel::load_default(options.device)?;
+                    let source = model.source.clone();
+                    (ModelFile::Network(Box::new(model)), source)
+                }
+            };
             let start = Instant::now();
             let (out, label) = model.clean(&motion, options.hop).map_err(in_file)?;
             (
                 out,
-                format!("{label} {}", path.display()),
-                start.elapsed().as_secs_f64(),
-            )
-        }
-        Method::DefaultModel => {
-            let model = CleanModel::load_default(options.device)?;
-            let start = Instant::now();
-            let (out, noise) = model
-                .clean_reporting(&motion, options.hop)
-                .map_err(in_file)?;
-            (
-                out,
-                format!("{} {}", model_label(noise), model.source.display()),
+                format!("{label} {}", source.display()),
                 start.elapsed().as_secs_f64(),
             )
         }
@@ -589,16 +579,11 @@ mod tests {
             let bytes = description_bytes(&model, description);
             CleanModel::from_bytes(bytes, Path::new("t"), DeviceChoice::Cpu)
                 .unwrap()
-                .clean(&noisy, None)
+                .clean_reporting(&noisy, None)
                 .unwrap()
         };
-        let with_context = cleaned_by(&description);
+        let (with_context, noise) = cleaned_by(&description);
         // A classical base estimates no noise level.
-        let bytes = description_bytes(&model, &description);
-        let (_, noise) = CleanModel::from_bytes(bytes, Path::new("t"), DeviceChoice::Cpu)
-            .unwrap()
-            .clean_reporting(&noisy, None)
-            .unwrap();
         assert_eq!(noise, None);
         let off = crate::eval::rotation_error_deg(&whole_take, &with_context);
         assert!(off < 1e-3, "{off} degrees from the whole-take filter");
@@ -606,7 +591,7 @@ mod tests {
             assert_eq!(with_context.root_translation(f), noisy.root_translation(f));
         }
         description.base_context = 0;
-        let per_window = cleaned_by(&description);
+        let (per_window, _) = cleaned_by(&description);
         let off = crate::eval::rotation_error_deg(&whole_take, &per_window);
         assert!(off > 0.05, "per-window filtering is only {off} degrees off");
     }

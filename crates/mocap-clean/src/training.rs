@@ -89,13 +89,6 @@ pub struct ModelDescription {
     pub base_wiener: Option<WienerDescription>,
 }
 
-impl ModelDescription {
-    /// Whether the network corrects a base filter rather than its input.
-    pub fn has_base(&self) -> bool {
-        self.base_filter.is_some() || self.base_wiener.is_some()
-    }
-}
-
 /// What a model's network corrects, ready to run: a classical filter at a
 /// frame rate ([`ModelDescription::base_filter`]) or a learned Wiener filter
 /// ([`ModelDescription::base_wiener`]).
@@ -105,7 +98,21 @@ pub(crate) enum Base<'a> {
     Wiener(&'a WienerFilter),
 }
 
-impl Base<'_> {
+impl<'a> Base<'a> {
+    /// The base of a model with `filter` at `fps` or `wiener` (at most one
+    /// of them: training and loading refuse both), if any.
+    pub(crate) fn of(
+        filter: Option<Filter>,
+        fps: f32,
+        wiener: Option<&'a WienerFilter>,
+    ) -> Option<Self> {
+        match (filter, wiener) {
+            (Some(filter), _) => Some(Base::Classical(filter, fps)),
+            (None, Some(wiener)) => Some(Base::Wiener(wiener)),
+            (None, None) => None,
+        }
+    }
+
     /// Filters `features` (frames x `channels`) in place; a Wiener filter
     /// also says the noise level it estimated (degrees).
     pub(crate) fn apply(&self, features: &mut [f32], channels: usize) -> Option<f64> {
@@ -560,8 +567,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .collect();
     let mut network = options.network;
     network.channels = layout.channels();
+    // Any base: a classical filter or a Wiener filter.
+    let any_base = options.base_filter.is_some() || options.base_wiener.is_some();
     if options.spike_detector {
-        if options.base_filter.is_some() || options.position_weight > 0.0 {
+        if any_base || options.position_weight > 0.0 {
             return Err(CleanError::Invalid(
                 "a spike detector has no base filter and no position term".into(),
             ));
@@ -579,8 +588,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             let wiener = WienerFilter::load(path)?;
             let why = if options.base_filter.is_some() {
                 Some("give a base filter or a base Wiener filter, not both".to_string())
-            } else if options.spike_detector || options.position_weight > 0.0 {
-                Some("a spike detector or a position term has no base filter".to_string())
             } else if options.representation != Representation::Rot6d
                 || options.frame != RotationFrame::Local
             {
@@ -607,7 +614,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             Some(wiener)
         }
     };
-    if options.base_context > 0 && options.base_filter.is_none() && base_wiener.is_none() {
+    if options.base_context > 0 && !any_base {
         return Err(CleanError::Invalid(
             "a base context needs a base filter (the context is what that filter sees)".into(),
         ));
@@ -622,11 +629,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         base_context: options.base_context,
         base_wiener: base_wiener.as_ref().map(|w| w.description.clone()),
     };
-    let base = match (&options.base_filter, &base_wiener) {
-        (Some(filter), _) => Some(Base::Classical(*filter, fps)),
-        (None, Some(wiener)) => Some(Base::Wiener(wiener)),
-        (None, None) => None,
-    };
+    let base = Base::of(options.base_filter, fps, base_wiener.as_ref());
     let loss = if options.derivative_loss {
         LossWeights::derivative(fps)
     } else {
@@ -644,7 +647,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         ..DataDescription::new(&options.inputs, &paths, options.split, fps as f64)
     };
 
-    if options.position_weight > 0.0 && options.base_filter.is_some() {
+    if options.position_weight > 0.0 && any_base {
         return Err(CleanError::Invalid(
             "the position term and a base filter do not go together (the term reads the network's output as rotations)".into(),
         ));

@@ -82,8 +82,6 @@ use crate::noise::{add_random_noise_sigma, RandomNoise};
 use crate::{CleanError, Result};
 
 type C64 = Complex<f64>;
-/// One segment's coefficients, one vector per frequency bin.
-type SegmentCoefficients = Vec<DVector<C64>>;
 
 /// Kind of a Wiener filter file (the checkpoint header's `kind`).
 pub const WIENER_KIND: &str = "mocap-clean/wiener";
@@ -384,9 +382,13 @@ impl WienerFilter {
         // a ridge of 1e-6 of its mean variance stands for the directions
         // with (almost) no noise, which the filter then passes through.
         let ridge = 1e-6 * noise.trace() / c as f64 + 1e-12;
-        let eigen = SymmetricEigen::new(&noise + DMatrix::<f64>::identity(c, c) * ridge);
+        // N = Q D Q^T once: its powers with the ridge for (1), and the
+        // directions it puts noise in for (2).
+        let eigen = SymmetricEigen::new(noise.clone());
         let root = |power: f64| {
-            let d = DMatrix::from_diagonal(&eigen.eigenvalues.map(|v| v.max(ridge).powf(power)));
+            let d = DMatrix::from_diagonal(
+                &eigen.eigenvalues.map(|v| (v.max(0.0) + ridge).powf(power)),
+            );
             (&eigen.eigenvectors * d * eigen.eigenvectors.transpose()).map(|v| C64::new(v, 0.0))
         };
         let (half, inverse_half) = (root(0.5), root(-0.5));
@@ -394,15 +396,14 @@ impl WienerFilter {
         // puts noise in: in the others the whitening has nothing but the
         // ridge to divide by, and any power the training spectra did not
         // foresee there would be taken for noise.
-        let noise_eigen = SymmetricEigen::new(noise.clone());
-        let largest = noise_eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let largest = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
         let noisy: Vec<usize> = (0..c)
-            .filter(|&i| noise_eigen.eigenvalues[i] > 1e-6 * largest && largest > 0.0)
+            .filter(|&i| eigen.eigenvalues[i] > 1e-6 * largest && largest > 0.0)
             .collect();
         let noisy_whitening = DMatrix::from_fn(noisy.len(), c, |k, j| {
             let i = noisy[k];
             C64::new(
-                noise_eigen.eigenvectors[(j, i)] / noise_eigen.eigenvalues[i].sqrt(),
+                eigen.eigenvectors[(j, i)] / eigen.eigenvalues[i].sqrt(),
                 0.0,
             )
         });
@@ -492,47 +493,36 @@ impl WienerFilter {
             .map(|k| k * len / 2)
             .take_while(|s| s + len <= total)
             .collect();
-        // Whitened coefficients z = V^H N^-1/2 X of every segment and bin,
-        // and those of the noisy directions (for judging the noise level).
-        let (white, noisy_white): (Vec<SegmentCoefficients>, Vec<SegmentCoefficients>) = starts
+        let spectra: Vec<DMatrix<C64>> = starts
             .par_iter()
-            .map(|&s| {
-                let spectrum = transforms.segment_spectrum(&padded, c, s, &window);
-                self.bins
-                    .iter()
-                    .enumerate()
-                    .map(|(b, bin)| {
-                        (
-                            &bin.to_white * spectrum.column(b),
-                            &bin.noisy_to_white * spectrum.column(b),
-                        )
-                    })
-                    .unzip()
-            })
-            .unzip();
-        // The noise level is estimated on the segments inside the take: the
-        // mirrored padding bends every channel at the take's ends, power
-        // the clean spectra never had (all segments when the take is
-        // shorter than one).
-        let inside: Vec<&SegmentCoefficients> = starts
-            .iter()
-            .zip(&noisy_white)
-            .filter(|(&s, _)| s >= len && s + len <= len + frames)
-            .map(|(_, z)| z)
+            .map(|&s| transforms.segment_spectrum(&padded, c, s, &window))
             .collect();
         let sigma = sigma_deg.unwrap_or_else(|| {
+            // Judged on the segments inside the take: the mirrored padding
+            // bends every channel at the take's ends, power the clean
+            // spectra never had (all segments when the take is shorter
+            // than one).
+            let inside: Vec<&DMatrix<C64>> = starts
+                .iter()
+                .zip(&spectra)
+                .filter(|(&s, _)| s >= len && s + len <= len + frames)
+                .map(|(_, spectrum)| spectrum)
+                .collect();
             if inside.is_empty() {
-                self.estimate_sigma_deg(&noisy_white.iter().collect::<Vec<_>>(), &window)
+                self.estimate_sigma_deg(&spectra.iter().collect::<Vec<_>>(), &window)
             } else {
                 self.estimate_sigma_deg(&inside, &window)
             }
         });
         let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
-        let filtered: Vec<Vec<f64>> = white
+        // (1) per segment and bin: whiten (z = V^H N^-1/2 X), scale each
+        // coordinate by lambda / (lambda + s), colour back.
+        let filtered: Vec<Vec<f64>> = spectra
             .par_iter()
-            .map(|z| {
+            .map(|x| {
                 let mut spectrum = DMatrix::<C64>::zeros(c, self.bins.len());
-                for (b, (bin, z)) in self.bins.iter().zip(z).enumerate() {
+                for (b, bin) in self.bins.iter().enumerate() {
+                    let z = &bin.to_white * x.column(b);
                     let gained = DVector::from_iterator(
                         c,
                         z.iter()
@@ -561,26 +551,39 @@ impl WienerFilter {
     }
 
     /// The noise level of largest marginal likelihood (2), from the
-    /// coefficients of the noisy directions (`Bin::noisy_to_white`) of segments.
-    fn estimate_sigma_deg(&self, noisy_white: &[&SegmentCoefficients], window: &[f64]) -> f64 {
+    /// spectra of segments taken through `Bin::noisy_to_white`.
+    fn estimate_sigma_deg(&self, spectra: &[&DMatrix<C64>], window: &[f64]) -> f64 {
         // Coefficients of a window v have variance (lambda + s) sum(v^2)
         // in the units the spectra were normalised to.
         let norm: f64 = window.iter().map(|v| v * v).sum();
         let len = self.description.segment;
         // Power per bin and coordinate, summed over segments.
-        let mut power: Vec<Vec<f64>> = self
-            .bins
-            .iter()
-            .map(|bin| vec![0.0; bin.noisy_lambda.len()])
-            .collect();
-        for z in noisy_white {
-            for (p, zb) in power.iter_mut().zip(z.iter()) {
-                for (pi, v) in p.iter_mut().zip(zb.iter()) {
-                    *pi += v.norm_sqr() / norm;
+        let empty = || -> Vec<Vec<f64>> {
+            self.bins
+                .iter()
+                .map(|bin| vec![0.0; bin.noisy_lambda.len()])
+                .collect()
+        };
+        let power = spectra
+            .par_iter()
+            .fold(empty, |mut power, x| {
+                for (b, (p, bin)) in power.iter_mut().zip(&self.bins).enumerate() {
+                    let z = &bin.noisy_to_white * x.column(b);
+                    for (pi, v) in p.iter_mut().zip(z.iter()) {
+                        *pi += v.norm_sqr() / norm;
+                    }
                 }
-            }
-        }
-        let n = noisy_white.len() as f64;
+                power
+            })
+            .reduce(empty, |mut a, b| {
+                for (pa, pb) in a.iter_mut().zip(&b) {
+                    for (x, y) in pa.iter_mut().zip(pb) {
+                        *x += y;
+                    }
+                }
+                a
+            });
+        let n = spectra.len() as f64;
         let log_likelihood = |s: f64| -> f64 {
             let mut total = 0.0;
             for (b, (bin, p)) in self.bins.iter().zip(&power).enumerate() {

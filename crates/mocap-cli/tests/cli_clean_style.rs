@@ -190,6 +190,22 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     assert!(!never.exists());
 }
 
+/// `mocap clean` of the bundled walk with `model`, written to
+/// `dir/clean.bvh`, the report as JSON on stdout.
+fn clean_walk_with(model: &Path, dir: &Path) -> std::process::Output {
+    let input = sample("dataset-1_walk_normal_001.bvh");
+    let output = dir.join("clean.bvh");
+    mocap(&[
+        "clean",
+        &input,
+        "-o",
+        path(&output),
+        "--model",
+        path(model),
+        "--json",
+    ])
+}
+
 /// Forty real dataset-2 takes copied into `dir/takes` (the 10% validation
 /// split by take gets several).
 fn forty_takes(dir: &Path, data: &Path) -> PathBuf {
@@ -224,18 +240,9 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     assert!(model.is_file());
     assert!(model.with_extension("png").is_file());
 
-    let output = dir.path().join("clean.bvh");
-    let input = sample("dataset-1_walk_normal_001.bvh");
-    let out = mocap(&[
-        "clean",
-        &input,
-        "-o",
-        path(&output),
-        "--model",
-        path(&model),
-    ]);
+    let out = clean_walk_with(&model, dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(output.is_file());
+    assert!(dir.path().join("clean.bvh").is_file());
 
     // On top of the cross-validated filter run over whole takes; the
     // description says so and `mocap clean` uses it.
@@ -254,14 +261,7 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["description"]["base_context"], 16);
-    let out = mocap(&[
-        "clean",
-        &input,
-        "-o",
-        path(&output),
-        "--model",
-        path(&based),
-    ]);
+    let out = clean_walk_with(&based, dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
 
     // The context without a base filter is a usage error.
@@ -297,17 +297,7 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     assert!(filter.is_file());
 
     // `mocap clean --model` tells the filter from a network by its header.
-    let output = dir.path().join("clean.bvh");
-    let input = sample("dataset-1_walk_normal_001.bvh");
-    let out = mocap(&[
-        "clean",
-        &input,
-        "-o",
-        path(&output),
-        "--model",
-        path(&filter),
-        "--json",
-    ]);
+    let out = clean_walk_with(&filter, dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(
@@ -317,7 +307,7 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
             .starts_with("Wiener filter"),
         "{report}"
     );
-    assert!(output.is_file());
+    assert!(dir.path().join("clean.bvh").is_file());
 
     // So does the evaluation.
     let label = format!("learned Wiener={}", path(&filter));
