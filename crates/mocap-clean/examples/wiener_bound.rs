@@ -46,7 +46,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let per_channel = wiener.per_channel();
     // The eigenvectors of the noise covariance: a basis in which the noise
     // channels are uncorrelated, for GCV per channel in that basis.
-    let noise_basis = SymmetricEigen::new(wiener.noise_covariance().clone()).eigenvectors;
+    let noise_eigen = SymmetricEigen::new(wiener.noise_covariance().clone());
+    let mut variances: Vec<f64> = noise_eigen.eigenvalues.iter().map(|v| v.max(0.0)).collect();
+    variances.sort_by(|a, b| b.total_cmp(a));
+    let total: f64 = variances.iter().sum();
+    let share = |k: usize| variances[..k.min(variances.len())].iter().sum::<f64>() / total;
+    println!(
+        "noise variance in the top 5 / 10 / 20 / 40 of {} eigen-directions of N: {:.3} / {:.3} / {:.3} / {:.3}",
+        variances.len(),
+        share(5),
+        share(10),
+        share(20),
+        share(40)
+    );
+    let noise_basis = noise_eigen.eigenvectors;
     let d = &wiener.description;
     println!(
         "fitted to {} training takes ({} frames, {} segments of {} frames; {} on other rigs left out) in {:.1} s",
