@@ -124,7 +124,7 @@ struct TrainArgs {
     /// instead of correcting its input (see bench/results/clean.md).
     #[arg(long, value_name = "SPEC")]
     base_filter: Option<Filter>,
-    /// With --base-filter: frames of the take the filter sees on each side of a training window;
+    /// With --base-filter or --base-wiener: frames of the take the filter sees on each side of a training window;
     /// the trained model then filters whole takes at once (for `butterworth-gcv`, whose cutoff
     /// needs a long stretch to be chosen well). 0: each window alone.
     #[arg(long, value_name = "FRAMES", requires = "base")]
