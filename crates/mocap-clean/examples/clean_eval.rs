@@ -2,7 +2,7 @@
 //!
 //! cargo run --release -p mocap-clean --example clean_eval -- --data ../shared/data/bandai \
 //!     [--model LABEL=FILE (LABEL without "=")]... [--no-default-model] [--no-filters] [--all-takes] \
-//!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] [--noise-above-pelvis] [--despike] \
+//!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] [--max-sigma DEG] [--noise-above-pelvis] [--despike] \
 //!     [--spike-model [LABEL=]FILE] [--json OUT.json] [--markdown OUT.md]
 
 use std::path::PathBuf;
@@ -42,6 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--max-takes" => o.max_takes = Some(value()?.parse()?),
             "--tune-takes" => o.tune_takes = value()?.parse()?,
             "--seed" => o.seed = value()?.parse()?,
+            "--max-sigma" => o.random.max_sigma_deg = value()?.parse()?,
             "--device" => o.device = value()?.parse()?,
             "--spike-lengths" => {
                 o.spike_lengths = value()?

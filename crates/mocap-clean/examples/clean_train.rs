@@ -3,7 +3,7 @@
 //! cargo run --release -p mocap-clean --example clean_train -- \
 //!     --data ../shared/data/bandai --out models/clean-default.safetensors \
 //!     [--epochs 20] [--steps 40] [--batch 512] [--lr 1e-3] [--seed 1] \
-//!     [--loss derivative|mse] [--representation rot6d|expmap|euler] [--rotations local|pelvis] [--base-filter SPEC | --base-wiener FILE] [--base-context FRAMES] \
+//!     [--loss derivative|mse] [--representation rot6d|expmap|euler] [--rotations local|pelvis] [--base-filter SPEC | --base-wiener FILE] [--base-context FRAMES] [--base-input] \
 //!     [--width 64] [--levels 2] [--blocks 1] [--window 16] [--large] \
 //!     [--max-sigma 10] [--spike-probability 0.5] [--max-spikes 3] [--spike-sigma 16] \
 //!     [--position-weight W] [--max-train-takes N] [--state DIR] [--resume] [--spike-detector] [--device cpu|cuda] [--json REPORT.json]
@@ -45,6 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--base-filter" => o.base_filter = Some(next(&mut i)?.parse()?),
             "--base-context" => o.base_context = next(&mut i)?.parse()?,
             "--base-wiener" => o.base_wiener = Some(PathBuf::from(next(&mut i)?)),
+            "--base-input" => o.base_input = true,
             "--width" => o.network.width = next(&mut i)?.parse()?,
             "--levels" => o.network.levels = next(&mut i)?.parse()?,
             "--blocks" => o.network.blocks = next(&mut i)?.parse()?,

@@ -222,24 +222,44 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
 /// and the spikes.
 pub fn remove_spikes(motion: &Motion, options: &DespikeOptions) -> (Motion, Vec<FoundSpike>) {
     let spikes = find_spikes(motion, options);
+    (bridge_spikes(motion, &spikes), spikes)
+}
+
+/// `motion` with the rotations of each spike's joint and subtree replaced,
+/// over its frames, by slerp from the frame before it to the frame after
+/// it; a spike at an end of the take holds the one frame next to it, and
+/// one covering the whole take is left as it is.
+pub fn bridge_spikes(motion: &Motion, spikes: &[FoundSpike]) -> Motion {
     let mut out = motion.clone();
     let skeleton = motion.skeleton();
-    for s in &spikes {
-        // Boundaries are found between frames 1 and frames - 1, so both
-        // frames of the bridge exist.
-        let (before, after) = (s.start - 1, s.start + s.frames);
+    let frames = motion.frame_count();
+    for s in spikes {
+        let end = (s.start + s.frames).min(frames);
+        let before = s.start.checked_sub(1);
+        let after = (end < frames).then_some(end);
+        if s.start >= end || (before.is_none() && after.is_none()) {
+            continue;
+        }
         for k in skeleton.subtree(s.joint) {
             if !skeleton.joint(k).has_rotation_channels() {
                 continue;
             }
-            let (a, b) = (out.local_rotation(before, k), out.local_rotation(after, k));
-            for f in s.start..after {
-                let w = (f - before) as f32 / (after - before) as f32;
-                out.set_local_rotation(f, k, slerp(a, b, w));
+            let rotation = |f: Option<usize>| f.map(|f| out.local_rotation(f, k));
+            let (a, b) = (rotation(before), rotation(after));
+            for f in s.start..end {
+                let q = match (a, b) {
+                    (Some(a), Some(b)) => {
+                        let (first, last) = (s.start - 1, end);
+                        slerp(a, b, (f - first) as f32 / (last - first) as f32)
+                    }
+                    (Some(q), None) | (None, Some(q)) => q,
+                    (None, None) => unreachable!("checked above"),
+                };
+                out.set_local_rotation(f, k, q);
             }
         }
     }
-    (out, spikes)
+    out
 }
 
 #[cfg(test)]
@@ -267,6 +287,42 @@ mod tests {
         let (noisy, spikes) =
             add_spikes(&clean, &[&donor], &SpikeNoise::default(), spikes, &mut rng).unwrap();
         (clean, noisy, spikes)
+    }
+
+    #[test]
+    fn spikes_at_the_ends_of_a_take_hold_the_frame_next_to_them() {
+        let motion = synthetic_motion_phase(20, 3, 0.4);
+        let spike = |start, frames| FoundSpike {
+            joint: 1,
+            start,
+            frames,
+        };
+        let bridged = bridge_spikes(&motion, &[spike(0, 4), spike(17, 3)]);
+        for f in 0..20 {
+            for j in 0..3 {
+                let expected = match (j, f) {
+                    (0, _) => motion.local_rotation(f, 0),
+                    (_, 0..4) => motion.local_rotation(4, j),
+                    (_, 17..) => motion.local_rotation(16, j),
+                    _ => motion.local_rotation(f, j),
+                };
+                assert!(
+                    bridged.local_rotation(f, j).abs_diff_eq(expected, 1e-6),
+                    "{f} {j}"
+                );
+            }
+        }
+        // Inside, the bridge runs from the frame before to the frame after.
+        let inside = bridge_spikes(&motion, &[spike(5, 4)]);
+        let (a, b) = (motion.local_rotation(4, 2), motion.local_rotation(9, 2));
+        assert!(inside
+            .local_rotation(7, 2)
+            .abs_diff_eq(slerp(a, b, 0.6), 1e-6));
+        // A spike over the whole take has nothing to bridge from.
+        assert_eq!(
+            bridge_spikes(&motion, &[spike(0, 20)]).values(),
+            motion.values()
+        );
     }
 
     #[test]

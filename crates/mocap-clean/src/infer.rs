@@ -30,7 +30,7 @@ use crate::filters::{filter_motion, Filter};
 use crate::model::{Denoiser, Head};
 use crate::spikes::{SpikeDetector, SpikeOptions};
 use crate::training::{
-    window_base, Base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION,
+    window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION,
 };
 use crate::wiener::{WienerFilter, WIENER_KIND};
 use crate::{CleanError, Result};
@@ -107,6 +107,20 @@ impl CleanModel {
         }
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad model description: {e}")))?;
+        let has_base = description.base_filter.is_some() || description.base_wiener.is_some();
+        let conditioning = if description.base_input {
+            description.network.channels + 1
+        } else {
+            0
+        };
+        if description.network.extra_inputs != conditioning || (description.base_input && !has_base)
+        {
+            return Err(bad(format!(
+                "the network reads {} extra inputs, its description asks for {conditioning}{}",
+                description.network.extra_inputs,
+                if has_base { "" } else { " and has no base" }
+            )));
+        }
         let device = device.device()?;
         let mut model = description.network.init(&device)?;
         if let Some(wiener) = &description.base_wiener {
@@ -180,6 +194,7 @@ impl CleanModel {
         }
         let layout = self.layout_for(motion)?;
         let c = layout.channels();
+        let ci = self.description.network.input_channels();
         let t = self.description.network.window;
         let hop = hop.unwrap_or(t / 4).clamp(1, t);
         let frames = motion.frame_count();
@@ -231,7 +246,7 @@ impl CleanModel {
         let mut start_index = 0;
         while start_index < windows {
             let n = batch.min(windows - start_index);
-            let mut x = vec![0.0; n * c * t];
+            let mut x = vec![0.0; n * ci * t];
             let mut offsets = Vec::with_capacity(n);
             // Per window, base(x) - x (see `ModelDescription::base_filter`).
             let mut base_corrections = Vec::new();
@@ -246,7 +261,7 @@ impl CleanModel {
                     window_base(&w, around, &recentering, base, c)
                 });
                 offsets.push(recentering);
-                if let Some(filtered) = filtered {
+                if let Some((filtered, window_level)) = filtered {
                     base_corrections.push(
                         filtered
                             .iter()
@@ -254,14 +269,17 @@ impl CleanModel {
                             .map(|(f, x)| f - x)
                             .collect::<Vec<f32>>(),
                     );
+                    if self.description.base_input {
+                        w = with_base_input(&w, &filtered, noise_deg.or(window_level), c);
+                    }
                 }
                 for f in 0..t {
-                    for ch in 0..c {
-                        x[(b * c + ch) * t + f] = w[f * c + ch];
+                    for ch in 0..ci {
+                        x[(b * ci + ch) * t + f] = w[f * ci + ch];
                     }
                 }
             }
-            let input = Tensor::<3>::from_data(TensorData::new(x, [n, c, t]), &self.device);
+            let input = Tensor::<3>::from_data(TensorData::new(x, [n, ci, t]), &self.device);
             let output = self.model.forward(input).into_data();
             let y: Vec<f32> = output
                 .try_to_vec()
@@ -531,6 +549,7 @@ mod tests {
             base_filter: None,
             base_context: 0,
             base_wiener: None,
+            base_input: false,
         };
         description_bytes(&model, &description)
     }
@@ -569,6 +588,7 @@ mod tests {
             base_filter: Some(filter),
             base_context: 64,
             base_wiener: None,
+            base_input: false,
         };
         let clean = crate::test_support::synthetic_motion_phase(150, joints, 0.3);
         let noise = crate::noise::RandomNoise::default();
@@ -653,5 +673,22 @@ mod tests {
         // A model for another skeleton is an error, not a panic.
         let other = synthetic_motion(20, 7);
         assert!(a.clean(&other, None).is_err());
+        // A description whose network does not read what it says is refused:
+        // a base input without a base, or without the inputs for it.
+        let refused = |description: &ModelDescription| {
+            let bytes = description_bytes(&a.model, description);
+            match CleanModel::from_bytes(bytes, &path, DeviceChoice::Cpu) {
+                Ok(_) => panic!("a model reading what it has not was accepted"),
+                Err(e) => e.to_string(),
+            }
+        };
+        let mut description = a.description.clone();
+        description.base_input = true;
+        let e = refused(&description);
+        assert!(e.contains("extra inputs") && e.contains("no base"), "{e}");
+        description.base_filter = Some(Filter::ButterworthGcv { order: 2 });
+        description.network.extra_inputs = 1;
+        let e = refused(&description);
+        assert!(e.contains("reads 1 extra inputs"), "{e}");
     }
 }

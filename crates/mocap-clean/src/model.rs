@@ -50,6 +50,18 @@ pub struct DenoiserConfig {
     /// What the network outputs (default: a denoised copy of its input).
     #[serde(default)]
     pub head: Head,
+    /// Input channels after the `channels` features that the network reads
+    /// but does not output or add to its output: what it is conditioned on
+    /// ([`crate::training::ModelDescription::base_input`]). 0 for models
+    /// written before this field.
+    #[serde(default)]
+    pub extra_inputs: usize,
+    /// The correction is the output layer's times the last input channel
+    /// (the noise level, [`crate::training::ModelDescription::base_input`]),
+    /// so that it vanishes on a take the base found clean. `false` for
+    /// models written before this field.
+    #[serde(default)]
+    pub level_gate: bool,
 }
 
 /// What the network outputs.
@@ -74,6 +86,8 @@ impl DenoiserConfig {
             kernel: 3,
             window: 16,
             head: Head::Correction,
+            extra_inputs: 0,
+            level_gate: false,
         }
     }
 
@@ -87,6 +101,8 @@ impl DenoiserConfig {
             kernel: 3,
             window: 16,
             head: Head::Correction,
+            extra_inputs: 0,
+            level_gate: false,
         }
     }
 
@@ -102,6 +118,9 @@ impl DenoiserConfig {
         if self.head == (Head::SpikeLogits { joints: 0 }) {
             return bad("a spike detector needs at least one joint");
         }
+        if self.level_gate && (self.extra_inputs == 0 || self.head != Head::Correction) {
+            return bad("a level gate needs a denoiser with a noise-level input");
+        }
         if self.levels > 6 || self.window == 0 || !self.window.is_multiple_of(1 << self.levels) {
             return bad("the window must be a positive multiple of 2^levels (levels at most 6)");
         }
@@ -112,7 +131,13 @@ impl DenoiserConfig {
         self.width << level
     }
 
-    /// Channels of the output: the input's, or one per joint.
+    /// Channels of the input: the features and what the network is
+    /// conditioned on.
+    pub fn input_channels(&self) -> usize {
+        self.channels + self.extra_inputs
+    }
+
+    /// Channels of the output: the features, or one per joint.
     pub fn output_channels(&self) -> usize {
         match self.head {
             Head::Correction => self.channels,
@@ -156,12 +181,14 @@ impl DenoiserConfig {
             });
         }
         Ok(Denoiser {
-            input: conv(self.channels, self.width),
+            input: conv(self.input_channels(), self.width),
             encoder,
             bottleneck: blocks(self.width_at(self.levels)),
             decoder,
             output: conv(self.width, self.output_channels()),
             residual: self.head == Head::Correction,
+            features: self.channels,
+            level_gate: self.level_gate,
             base: None,
         })
     }
@@ -171,8 +198,8 @@ impl DenoiserConfig {
         let k = self.kernel;
         let conv = |cin: usize, cout: usize, k: usize| cin * cout * k + cout;
         let block = |w: usize| 2 * conv(w, w, k);
-        let mut n =
-            conv(self.channels, self.width, k) + conv(self.width, self.output_channels(), k);
+        let mut n = conv(self.input_channels(), self.width, k)
+            + conv(self.width, self.output_channels(), k);
         for level in 0..self.levels {
             let (w, w2) = (self.width_at(level), self.width_at(level + 1));
             n += 2 * self.blocks * block(w) + conv(w, w2, 4) + (w2 * w * 4 + w);
@@ -219,6 +246,13 @@ pub struct Denoiser {
     /// a spike detector). Not a weight: it comes from the configuration.
     #[module(skip)]
     residual: bool,
+    /// How many of the input's channels are features (the rest condition
+    /// the network): the global skip adds those. Not a weight.
+    #[module(skip)]
+    features: usize,
+    /// See [`DenoiserConfig::level_gate`]. Not a weight.
+    #[module(skip)]
+    level_gate: bool,
     /// The learned Wiener filter the network corrects, when it does
     /// ([`crate::training::ModelDescription::base_wiener`]): not trained and
     /// not used by `forward`; it rides along so that one file holds the
@@ -250,9 +284,13 @@ impl Denoiser {
                 h = b.forward(h);
             }
         }
-        let out = self.output.forward(h);
+        let mut out = self.output.forward(h);
+        if self.level_gate {
+            let inputs = x.dims()[1];
+            out = out * x.clone().narrow(1, inputs - 1, 1);
+        }
         if self.residual {
-            x + out
+            x.narrow(1, 0, self.features) + out
         } else {
             out
         }
@@ -296,6 +334,71 @@ mod tests {
         let x = Tensor::<3>::zeros([3, 12, 16], &device);
         assert_eq!(model.forward(x).dims(), [3, 2, 16]);
         assert_eq!(model.num_params(), config.parameter_count());
+    }
+
+    #[test]
+    fn a_conditioned_denoiser_outputs_and_skips_only_the_features() {
+        let device = Device::flex();
+        let config = DenoiserConfig {
+            extra_inputs: 5,
+            ..DenoiserConfig::small(12)
+        };
+        let mut model = config.init(&device).unwrap();
+        assert_eq!(model.num_params(), config.parameter_count());
+        // Features 1..=12 per channel, conditioning channels far off: with
+        // its output layer zeroed the network gives back the features only.
+        let values: Vec<f32> = (0..17)
+            .flat_map(|ch| std::iter::repeat_n(if ch < 12 { ch as f32 } else { 100.0 }, 16))
+            .collect();
+        let x = Tensor::<3>::from_data(burn::tensor::TensorData::new(values, [1, 17, 16]), &device);
+        model.zero_output();
+        let y: Vec<f32> = model.forward(x).into_data().try_to_vec().unwrap();
+        assert_eq!(y.len(), 12 * 16);
+        for (i, v) in y.iter().enumerate() {
+            assert_eq!(*v, (i / 16) as f32);
+        }
+    }
+
+    #[test]
+    fn a_level_gate_scales_the_correction_by_the_last_input() {
+        let device = Device::flex();
+        let config = DenoiserConfig {
+            extra_inputs: 2,
+            level_gate: true,
+            ..DenoiserConfig::small(4)
+        };
+        let model = config.init(&device).unwrap();
+        let input = |level: f32| {
+            let values: Vec<f32> = (0..6 * 16)
+                .map(|i| {
+                    if i >= 5 * 16 {
+                        level
+                    } else {
+                        (i as f32 * 0.37).sin()
+                    }
+                })
+                .collect();
+            Tensor::<3>::from_data(burn::tensor::TensorData::new(values, [1, 6, 16]), &device)
+        };
+        let correction = |level: f32| -> Vec<f32> {
+            let x = input(level);
+            let features = x.clone().narrow(1, 0, 4);
+            (model.forward(x) - features)
+                .into_data()
+                .try_to_vec()
+                .unwrap()
+        };
+        // At level 0 nothing changes; the correction grows with the level
+        // (the network reads the level too, so not exactly in proportion).
+        assert!(correction(0.0).iter().all(|&v| v == 0.0));
+        let size = |v: Vec<f32>| v.iter().map(|x| x.abs()).sum::<f32>();
+        assert!(size(correction(0.5)) > 0.0);
+        assert!(size(correction(0.01)) < 0.1 * size(correction(0.5)));
+        let bad = DenoiserConfig {
+            level_gate: true,
+            ..DenoiserConfig::small(4)
+        };
+        assert!(bad.validate().is_err());
     }
 
     #[test]

@@ -180,20 +180,28 @@ fn centred(x: &[f32], c: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// `x` (frames x c) padded with `pad` frames on each side, mirrored about
 /// the end frames (bouncing again where the take is shorter than `pad`).
-fn reflect_pad(x: &[f64], c: usize, pad: usize) -> Vec<f64> {
-    let frames = (x.len() / c) as isize;
+fn reflect_pad<T: Copy>(x: &[T], c: usize, pad: usize) -> Vec<T> {
+    let frames = x.len() / c;
     let mut out = Vec::with_capacity(x.len() + 2 * pad * c);
-    for i in 0..frames + 2 * pad as isize {
-        let mut f = i - pad as isize;
-        if frames == 1 {
-            f = 0;
-        }
-        while f < 0 || f >= frames {
-            f = if f < 0 { -f } else { 2 * (frames - 1) - f };
-        }
-        out.extend_from_slice(&x[f as usize * c..(f as usize + 1) * c]);
+    for i in 0..frames + 2 * pad {
+        let f = reflected_frame(i, frames, pad);
+        out.extend_from_slice(&x[f * c..(f + 1) * c]);
     }
     out
+}
+
+/// The frame of a take of `frames` frames at index `i` of its copy padded
+/// by reflection with `pad` frames on each side (see [`reflect_pad`]).
+fn reflected_frame(i: usize, frames: usize, pad: usize) -> usize {
+    let frames = frames as isize;
+    let mut f = i as isize - pad as isize;
+    if frames == 1 {
+        f = 0;
+    }
+    while f < 0 || f >= frames {
+        f = if f < 0 { -f } else { 2 * (frames - 1) - f };
+    }
+    f as usize
 }
 
 /// Forward and inverse Fourier transforms of one segment length
@@ -476,6 +484,31 @@ impl WienerFilter {
 
     /// Filters features of the fitted rig in place (frames x channels).
     pub fn filter_features(&self, features: &mut [f32], sigma_deg: Option<f64>) -> WienerOutcome {
+        self.filter_features_missing(features, sigma_deg, None)
+    }
+
+    /// [`WienerFilter::filter_features`] with some values marked missing
+    /// (`missing`: frames x channels, as `features`): in every segment that
+    /// holds a missing value of a channel, that channel is not read at all
+    /// and is estimated from the others, the conditional mean of the
+    /// Gaussian model of (1):
+    ///
+    /// ```text
+    /// Y(f) = S(f) (S(f) + s N + D)^-1 X(f)                              (3)
+    /// ```
+    ///
+    /// `D` being a huge variance on those channels (a direct solve per
+    /// segment and bin, where (1) reuses one eigendecomposition). What it
+    /// is for: a spike replaces a subtree's rotations with another motion's,
+    /// so its values say nothing of the clean ones, but the rest of the body
+    /// does (an arm swings with the legs). The noise level is still
+    /// estimated on every segment inside the take.
+    pub fn filter_features_missing(
+        &self,
+        features: &mut [f32],
+        sigma_deg: Option<f64>,
+        missing: Option<&[bool]>,
+    ) -> WienerOutcome {
         let c = self.description.channels;
         let len = self.description.segment;
         let frames = features.len() / c;
@@ -515,11 +548,21 @@ impl WienerFilter {
             }
         });
         let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
+        let padded_missing = missing.map(|m| reflect_pad(&m[..frames * c], c, len));
         // (1) per segment and bin: whiten (z = V^H N^-1/2 X), scale each
         // coordinate by lambda / (lambda + s), colour back.
-        let filtered: Vec<Vec<f64>> = spectra
+        let filtered: Vec<Vec<f64>> = starts
             .par_iter()
-            .map(|x| {
+            .zip(&spectra)
+            .map(|(&start, x)| {
+                let gone: Vec<usize> = padded_missing.as_ref().map_or(Vec::new(), |m| {
+                    (0..c)
+                        .filter(|&k| (start..start + len).any(|t| m[t * c + k]))
+                        .collect()
+                });
+                if !gone.is_empty() {
+                    return transforms.inverse_segment(&self.conditional_mean(x, s, &gone));
+                }
                 let mut spectrum = DMatrix::<C64>::zeros(c, self.bins.len());
                 for (b, bin) in self.bins.iter().enumerate() {
                     let z = &bin.to_white * x.column(b);
@@ -548,6 +591,34 @@ impl WienerFilter {
             *f = (sum[len * c + i] + mean[i % c]) as f32;
         }
         WienerOutcome { sigma_deg: sigma }
+    }
+
+    /// (3) for one segment's bins `x` (`c x bins`) at noise level `s`, the
+    /// channels `gone` not read.
+    fn conditional_mean(&self, x: &DMatrix<C64>, s: f64, gone: &[usize]) -> DMatrix<C64> {
+        let c = self.description.channels;
+        let ridge = 1e-6 * self.noise.trace() / c as f64 + 1e-12;
+        let mut out = DMatrix::<C64>::zeros(c, self.bins.len());
+        for (b, spectrum) in self.spectra.iter().enumerate() {
+            // Far above any channel's power: the channel's value is noise.
+            let unknown = 1e6 * (spectrum.trace().re / c as f64 + ridge);
+            let mut total = spectrum.clone();
+            for i in 0..c {
+                for j in 0..c {
+                    total[(i, j)] += C64::new(s * self.noise[(i, j)], 0.0);
+                }
+                total[(i, i)] += C64::new(s * ridge, 0.0);
+            }
+            for &k in gone {
+                total[(k, k)] += C64::new(unknown, 0.0);
+            }
+            let solved = total
+                .lu()
+                .solve(&x.column(b).into_owned())
+                .unwrap_or_else(|| DVector::zeros(c));
+            out.set_column(b, &(spectrum * solved));
+        }
+        out
     }
 
     /// The noise level of largest marginal likelihood (2), from the
@@ -909,6 +980,60 @@ mod tests {
                 .fold(0.0, f32::max);
             assert!(most < 1e-5, "{frames} frames: off by {most}");
         }
+    }
+
+    #[test]
+    fn values_marked_missing_are_estimated_from_the_other_channels() {
+        let filter = fitted();
+        let layout = FeatureLayout::new(
+            synthetic_motion_phase(2, 5, 0.0).skeleton(),
+            Representation::Rot6d,
+        )
+        .unwrap();
+        let c = layout.channels();
+        let clean = layout.encode(&synthetic_motion_phase(300, 5, 0.35));
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let noisy = layout.encode(&add_random_noise_sigma(
+            &synthetic_motion_phase(300, 5, 0.35),
+            2.0,
+            &RandomNoise::default(),
+            &mut rng,
+        ));
+        // Nothing missing: exactly the plain filter.
+        let (mut plain, mut none) = (noisy.clone(), noisy.clone());
+        filter.filter_features(&mut plain, Some(2.0));
+        filter.filter_features_missing(&mut none, Some(2.0), Some(&vec![false; noisy.len()]));
+        assert_eq!(plain, none);
+        // A joint's 6 channels taken from another motion for 40 frames.
+        let other = layout.encode(&synthetic_motion_phase(300, 5, 2.1));
+        let (joint, frames) = (2, 130..170);
+        let mut spiked = noisy.clone();
+        let mut missing = vec![false; noisy.len()];
+        for f in frames.clone() {
+            for k in joint * 6..joint * 6 + 6 {
+                spiked[f * c + k] = other[f * c + k];
+                missing[f * c + k] = true;
+            }
+        }
+        let error = |y: &[f32]| -> f32 {
+            frames
+                .clone()
+                .flat_map(|f| (joint * 6..joint * 6 + 6).map(move |k| f * c + k))
+                .map(|i| (y[i] - clean[i]).powi(2))
+                .sum::<f32>()
+                .sqrt()
+        };
+        let (mut blind, mut told) = (spiked.clone(), spiked.clone());
+        filter.filter_features(&mut blind, Some(2.0));
+        filter.filter_features_missing(&mut told, Some(2.0), Some(&missing));
+        assert!(
+            error(&told) < 0.3 * error(&blind),
+            "missing values: {} against {} read as they are",
+            error(&told),
+            error(&blind)
+        );
+        // Away from the marked segments nothing changes.
+        assert_eq!(&told[..64 * c], &blind[..64 * c]);
     }
 
     #[test]

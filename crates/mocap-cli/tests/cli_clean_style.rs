@@ -330,6 +330,46 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("learned Wiener"), "{text}");
 
+    // --max-sigma 0: what a method does to clean takes (the random
+    // condition's input is then the clean take); a negative level is a usage
+    // error that says what is expected.
+    let eval_at = |level: &str| {
+        mocap(&[
+            "clean",
+            "eval",
+            path(&takes),
+            "--all-takes",
+            "--max-takes",
+            "2",
+            "--no-default-model",
+            "--no-filters",
+            "--spike-lengths",
+            "none",
+            "--model",
+            &label,
+            &format!("--max-sigma={level}"),
+            "--json",
+        ])
+    };
+    let out = eval_at("0");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let entry = |method: &str| {
+        report["entries"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["condition"] == "random" && e["method"] == method)
+            .unwrap_or_else(|| panic!("no {method} entry: {report}"))["rotation_error_deg"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(entry("noisy input") < 1e-3, "{report}");
+    assert!(entry("learned Wiener") < 1.0, "{report}");
+    let out = eval_at("-1");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("0 or more"), "{}", stderr(&out));
+
     // Network options do not go with --wiener.
     let out = mocap(&[
         "clean",

@@ -133,6 +133,10 @@ struct TrainArgs {
     /// of a classical --base-filter; the model file then holds both. Use with --base-context.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["base_filter", "spike_detector", "position_weight"])]
     base_wiener: Option<PathBuf>,
+    /// With --base-filter or --base-wiener: the network also reads the filter's output and the noise
+    /// level it estimated, so it can leave a clean take alone (see bench/results/clean.md).
+    #[arg(long, requires = "base")]
+    base_input: bool,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
@@ -188,7 +192,7 @@ struct TrainArgs {
         "spike_detector", "base_filter", "resume", "large", "epochs", "steps", "batch", "lr",
         "representation", "rotations", "position_weight", "width", "levels", "blocks", "window",
         "max_sigma", "spike_probability", "max_spikes", "spike_sigma", "plot", "state", "base_wiener",
-        "base_context",
+        "base_context", "base_input",
     ])]
     wiener: bool,
     /// With --wiener: frames per Fourier segment (default 32).
@@ -243,6 +247,10 @@ struct EvalArgs {
     /// this became the default; see bench/results/clean.md).
     #[arg(long)]
     noise_above_pelvis: bool,
+    /// Largest standard deviation of the random noise, degrees; each take draws its own in
+    /// [0, MAX] (default: the report's 10; 0 measures what a method does to clean takes).
+    #[arg(long, value_name = "MAX", value_parser = degrees_at_least_zero)]
+    max_sigma: Option<f32>,
     #[arg(long)]
     seed: Option<u64>,
     #[arg(long, default_value = "cpu")]
@@ -348,6 +356,7 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     set(&mut o.frame, a.rotations);
     o.base_filter = a.base_filter;
     o.base_wiener = a.base_wiener;
+    o.base_input = a.base_input;
     set(&mut o.base_context, a.base_context);
     set(&mut o.position_weight, a.position_weight);
     set(&mut o.network.width, a.width);
@@ -428,6 +437,7 @@ fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
         ..EvalOptions::default()
     };
     o.random.perturb_above_pelvis = a.noise_above_pelvis;
+    set(&mut o.random.max_sigma_deg, a.max_sigma);
     o.despike = a.despike;
     o.spike_detector = a.spike_model.map(|path| ModelEntry {
         label: "spike detector".into(),
@@ -487,6 +497,16 @@ fn parse_lengths(text: &str) -> anyhow::Result<Vec<usize>> {
 }
 
 /// Overrides a default when the option was given.
+/// Parses a noise level: a finite number of degrees, zero or more.
+fn degrees_at_least_zero(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a number of degrees, 0 or more, got `{text}`"
+        )),
+    }
+}
+
 fn set<T>(slot: &mut T, value: Option<T>) {
     if let Some(v) = value {
         *slot = v;

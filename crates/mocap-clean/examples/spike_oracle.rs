@@ -1,0 +1,205 @@
+//! Study: how far could spikes be taken out if we knew where they are?
+//!
+//! An upper bound for spike finding, on validation takes with random noise of
+//! fixed sigma plus 1-3 spikes (the evaluation's spike noise): the spikes'
+//! joints and frames are taken from the noise generator (an oracle), and
+//! each spiked subtree is either
+//!
+//! - bridged (slerp from the frame before the spike to the frame after it,
+//!   what `mocap clean --despike` does with the spikes it finds), then the
+//!   learned Wiener filter runs; or
+//! - bridged, then marked missing for the Wiener filter, which estimates it
+//!   from the rest of the body in every segment the spike touches
+//!   (`WienerFilter::filter_features_missing`, (3)); or
+//! - both: the bridged take's filtered output outside the spikes and the
+//!   estimate from the rest of the body over the spikes' frames.
+//!
+//! A last row draws each take's sigma uniformly in [0, 10] degrees, as the
+//! evaluation's spike condition does (`mocap clean eval`).
+//!
+//! Against: the noisy input, the best fixed Butterworth on the evaluation's
+//! spike condition (2nd order, 2 Hz), the Wiener filter reading the spikes
+//! as they are, and the Wiener filter on the same take without spikes (what
+//! perfect spike removal would give). Mean rotation error over all joints
+//! and frames (degrees).
+//!
+//! cargo run --profile test -p mocap-clean --example spike_oracle -- DATA [TAKES] [SIGMAS] [WIENER_FILE]
+
+mod support;
+
+use std::time::Instant;
+
+use mocap_clean::dataset::{
+    list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions,
+};
+use mocap_clean::despike::{bridge_spikes, FoundSpike};
+use mocap_clean::eval::rotation_error_deg;
+use mocap_clean::features::{FeatureLayout, Representation};
+use mocap_clean::filters::{filter_motion, Filter};
+use mocap_clean::noise::{
+    add_random_noise, add_random_noise_sigma, add_spike_noise, RandomNoise, Spike, SpikeNoise,
+};
+use mocap_clean::wiener::WienerFilter;
+use mocap_core::Motion;
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+
+/// The methods, in table order.
+const METHODS: [&str; 7] = [
+    "noisy input",
+    "butterworth 2 Hz",
+    "Wiener filter",
+    "oracle: bridge, Wiener",
+    "oracle: bridge, Wiener told the spikes are missing",
+    "oracle: bridge, Wiener; spike frames from the rest of the body",
+    "Wiener filter, same take without spikes",
+];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let support::StudyArgs {
+        data,
+        takes: max_takes,
+        sigmas,
+        rest,
+    } = support::parse()?;
+    let wiener_path = rest
+        .first()
+        .map_or("models/clean-wiener.safetensors", String::as_str);
+    let wiener = WienerFilter::load(std::path::Path::new(wiener_path))?;
+    let all = list_bvh(&[data])?;
+    let mut takes = load_takes(&paths_in_split(
+        &all,
+        Split::Validation,
+        &SplitFractions::default(),
+    ))?;
+    takes.truncate(max_takes);
+    let frames: usize = takes.iter().map(|t| t.motion.frame_count()).sum();
+    println!(
+        "{} validation takes, {frames} frames; random noise of the given sigma, then 1-3 spikes (sd 16 frames) \
+         from other takes; Wiener filter {wiener_path}; mean rotation error (degrees), frame-weighted.\n",
+        takes.len()
+    );
+    print!("| sigma (deg) |");
+    for m in METHODS {
+        print!(" {m} |");
+    }
+    println!("\n| ---: |{}", " ---: |".repeat(METHODS.len()));
+    let started = Instant::now();
+    // Fixed levels, then (None) a level drawn per take in [0, 10].
+    let levels: Vec<Option<f32>> = sigmas.iter().map(|&s| Some(s)).chain([None]).collect();
+    for &level in &levels {
+        let per_take: Vec<[f64; METHODS.len()]> = (0..takes.len())
+            .into_par_iter()
+            .map(|i| {
+                let key = level.map_or(u32::MAX, f32::to_bits) as u64;
+                let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+                let clean = &takes[i].motion;
+                let n = clean.frame_count();
+                let noisy = match level {
+                    Some(sigma) => {
+                        add_random_noise_sigma(clean, sigma, &RandomNoise::default(), &mut rng)
+                    }
+                    None => add_random_noise(clean, &RandomNoise::default(), &mut rng).0,
+                };
+                let donors: Vec<Motion> = (0..3)
+                    .map(|_| {
+                        let mut d = rng.random_range(0..takes.len());
+                        if d == i {
+                            d = (d + 1) % takes.len();
+                        }
+                        let donor = &takes[d].motion;
+                        looped_window(donor, rng.random_range(0..donor.frame_count()), n)
+                    })
+                    .collect();
+                let donor_refs: Vec<&Motion> = donors.iter().collect();
+                let (spiked, spikes) =
+                    add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
+                        .expect("spikes");
+                let found: Vec<FoundSpike> = spikes
+                    .iter()
+                    .map(
+                        |&Spike {
+                             joint,
+                             start,
+                             frames,
+                         }| FoundSpike {
+                            joint,
+                            start,
+                            frames,
+                        },
+                    )
+                    .collect();
+                let bridged = bridge_spikes(&spiked, &found);
+                let layout =
+                    FeatureLayout::new(clean.skeleton(), Representation::Rot6d).expect("rig");
+                let c = layout.channels();
+                // Channels of every spiked joint and its subtree, over the
+                // spike's frames.
+                let mut missing = vec![false; n * c];
+                for s in &spikes {
+                    for k in clean.skeleton().subtree(s.joint) {
+                        let Some(slot) = layout.joints.iter().position(|&j| j == k) else {
+                            continue;
+                        };
+                        for f in s.start..(s.start + s.frames).min(n) {
+                            for ch in slot * 6..slot * 6 + 6 {
+                                missing[f * c + ch] = true;
+                            }
+                        }
+                    }
+                }
+                let run = |motion: &Motion, told: bool| -> Vec<f32> {
+                    let mut features = layout.encode(motion);
+                    wiener.filter_features_missing(
+                        &mut features,
+                        None,
+                        told.then_some(&missing[..]),
+                    );
+                    features
+                };
+                let decoded = |features: &[f32]| {
+                    let mut out = clean.clone();
+                    layout.decode_into(features, &mut out);
+                    out
+                };
+                let bridged_filtered = run(&bridged, false);
+                let bridged_told = run(&bridged, true);
+                let combined: Vec<f32> = bridged_filtered
+                    .iter()
+                    .zip(&bridged_told)
+                    .zip(&missing)
+                    .map(|((&a, &b), &gone)| if gone { b } else { a })
+                    .collect();
+                let outputs = [
+                    spiked.clone(),
+                    filter_motion(
+                        &spiked,
+                        &Filter::Butterworth {
+                            order: 2,
+                            cutoff_hz: 2.0,
+                        },
+                    )
+                    .expect("filter"),
+                    decoded(&run(&spiked, false)),
+                    decoded(&bridged_filtered),
+                    decoded(&bridged_told),
+                    decoded(&combined),
+                    decoded(&run(&noisy, false)),
+                ];
+                outputs.map(|out| rotation_error_deg(clean, &out) * n as f64)
+            })
+            .collect();
+        match level {
+            Some(sigma) => print!("| {sigma} |"),
+            None => print!("| drawn in 0-10 |"),
+        }
+        for m in 0..METHODS.len() {
+            let sum: f64 = per_take.iter().map(|e| e[m]).sum();
+            print!(" {:.3} |", sum / frames as f64);
+        }
+        println!();
+    }
+    println!("\n{:.0} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
