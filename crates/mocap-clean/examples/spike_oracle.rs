@@ -57,23 +57,19 @@ const METHODS: [&str; 7] = [
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let support::StudyArgs {
-        data,
-        takes: max_takes,
-        sigmas,
-        rest,
-    } = support::parse()?;
-    let wiener_path = rest
+    let args = support::parse()?;
+    let wiener_path = args
+        .rest
         .first()
         .map_or("models/clean-wiener.safetensors", String::as_str);
     let wiener = WienerFilter::load(std::path::Path::new(wiener_path))?;
-    let all = list_bvh(&[data])?;
+    let all = list_bvh(&[args.data])?;
     let mut takes = load_takes(&paths_in_split(
         &all,
         Split::Validation,
         &SplitFractions::default(),
     ))?;
-    takes.truncate(max_takes);
+    takes.truncate(args.takes);
     let frames: usize = takes.iter().map(|t| t.motion.frame_count()).sum();
     println!(
         "{} validation takes, {frames} frames; random noise of the given sigma, then 1-3 spikes (sd 16 frames) \
@@ -87,7 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("\n| ---: |{}", " ---: |".repeat(METHODS.len()));
     let started = Instant::now();
     // Fixed levels, then (None) a level drawn per take in [0, 10].
-    let levels: Vec<Option<f32>> = sigmas.iter().map(|&s| Some(s)).chain([None]).collect();
+    let levels: Vec<Option<f32>> = args.sigmas.iter().map(|&s| Some(s)).chain([None]).collect();
     for &level in &levels {
         let per_take: Vec<[f64; METHODS.len()]> = (0..takes.len())
             .into_par_iter()

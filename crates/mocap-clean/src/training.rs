@@ -694,10 +694,14 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 .into(),
         ));
     }
-    if options.base_input {
-        network.extra_inputs = layout.channels() + 1;
-        network.level_gate = true;
-    }
+    // What the network reads besides the features follows from the options
+    // alone (a configuration copied from another model may say otherwise).
+    network.extra_inputs = if options.base_input {
+        layout.channels() + 1
+    } else {
+        0
+    };
+    network.level_gate = options.base_input;
     if options.base_context > 0 && !any_base {
         return Err(CleanError::Invalid(
             "a base context needs a base filter (the context is what that filter sees)".into(),
@@ -1218,12 +1222,12 @@ mod tests {
         assert!(error.contains("base filter"), "{error}");
     }
 
-    #[test]
-    fn a_model_on_a_wiener_filter_carries_it_and_corrects_it() {
-        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-        let dir = tempfile::tempdir().unwrap();
-        let setup = tiny_setup(dir.path());
-        let wiener_path = dir.path().join("wiener.safetensors");
+    /// [`tiny_setup`] on a Wiener filter fitted to its takes (written to
+    /// `wiener.safetensors` in `dir`), the filter seeing 16 frames around
+    /// each window; the model is written to `out` in `dir`.
+    fn tiny_setup_on_wiener(dir: &Path, out: &str) -> (TrainOptions, PathBuf) {
+        let setup = tiny_setup(dir);
+        let wiener_path = dir.join("wiener.safetensors");
         crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
             inputs: setup.inputs.clone(),
             out: wiener_path.clone(),
@@ -1232,11 +1236,19 @@ mod tests {
         })
         .unwrap();
         let options = TrainOptions {
-            out: dir.path().join("on-wiener.safetensors"),
+            out: dir.join(out),
             base_wiener: Some(wiener_path.clone()),
             base_context: 16,
             ..setup
         };
+        (options, wiener_path)
+    }
+
+    #[test]
+    fn a_model_on_a_wiener_filter_carries_it_and_corrects_it() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let (options, wiener_path) = tiny_setup_on_wiener(dir.path(), "on-wiener.safetensors");
         let report = train(&options).unwrap();
         // The model's file alone is enough: the filter rides in it.
         let kept = dir.path().join("kept.safetensors");
@@ -1296,21 +1308,10 @@ mod tests {
     fn a_model_reading_its_base_gets_the_filter_output_and_the_noise_level() {
         let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();
-        let setup = tiny_setup(dir.path());
-        let wiener_path = dir.path().join("wiener.safetensors");
-        crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
-            inputs: setup.inputs.clone(),
-            out: wiener_path.clone(),
-            split: setup.split,
-            ..Default::default()
-        })
-        .unwrap();
+        let (on_wiener, _) = tiny_setup_on_wiener(dir.path(), "reads-base.safetensors");
         let options = TrainOptions {
-            out: dir.path().join("reads-base.safetensors"),
-            base_wiener: Some(wiener_path.clone()),
-            base_context: 16,
             base_input: true,
-            ..setup.clone()
+            ..on_wiener
         };
         let report = train(&options).unwrap();
         let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
@@ -1319,7 +1320,7 @@ mod tests {
         assert_eq!(model.description.network.input_channels(), 2 * c + 1);
 
         // The training windows: features, the filter's output, the level.
-        let takes = load_takes(&list_bvh(&setup.inputs).unwrap()).unwrap();
+        let takes = load_takes(&list_bvh(&options.inputs).unwrap()).unwrap();
         let layout = FeatureLayout::new(takes[0].motion.skeleton(), Representation::Rot6d).unwrap();
         let wiener = model_base(&model).clone();
         let t = model.description.network.window;

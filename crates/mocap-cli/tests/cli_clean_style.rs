@@ -309,32 +309,11 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     );
     assert!(dir.path().join("clean.bvh").is_file());
 
-    // So does the evaluation.
+    // So does the evaluation (of 2 takes, the Wiener filter alone, with
+    // more options).
     let label = format!("learned Wiener={}", path(&filter));
-    let out = mocap(&[
-        "clean",
-        "eval",
-        path(&takes),
-        "--all-takes",
-        "--max-takes",
-        "2",
-        "--no-default-model",
-        "--no-filters",
-        "--spike-lengths",
-        "none",
-        "--model",
-        &label,
-        "--json",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("learned Wiener"), "{text}");
-
-    // --max-sigma 0: what a method does to clean takes (the random
-    // condition's input is then the clean take); a negative level is a usage
-    // error that says what is expected.
-    let eval_at = |level: &str| {
-        mocap(&[
+    let eval_with = |more: &[&str]| {
+        let mut args = vec![
             "clean",
             "eval",
             path(&takes),
@@ -347,11 +326,20 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
             "none",
             "--model",
             &label,
-            &format!("--max-sigma={level}"),
             "--json",
-        ])
+        ];
+        args.extend_from_slice(more);
+        mocap(&args)
     };
-    let out = eval_at("0");
+    let out = eval_with(&[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("learned Wiener"), "{text}");
+
+    // --max-sigma 0: what a method does to clean takes (the random
+    // condition's input is then the clean take); a negative level is a usage
+    // error that says what is expected.
+    let out = eval_with(&["--max-sigma=0"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let entry = |method: &str| {
@@ -366,7 +354,7 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     };
     assert!(entry("noisy input") < 1e-3, "{report}");
     assert!(entry("learned Wiener") < 1.0, "{report}");
-    let out = eval_at("-1");
+    let out = eval_with(&["--max-sigma=-1"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("0 or more"), "{}", stderr(&out));
 
