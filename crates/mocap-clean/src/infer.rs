@@ -74,7 +74,7 @@ impl CleanModel {
 
     /// The shipped default model, or the file named by the
     /// `MOCAP_CLEAN_MODEL` environment variable. The default model
-    /// (`models/clean-default.safetensors`, about 6.5 MB with the Wiener filter it corrects) is compiled into the
+    /// (`models/clean-default.safetensors`, about 6.6 MB with the Wiener filter it corrects) is compiled into the
     /// binary, so it works wherever the binary is installed.
     pub fn load_default(device: DeviceChoice) -> Result<CleanModel> {
         if let Some(path) = std::env::var_os("MOCAP_CLEAN_MODEL") {

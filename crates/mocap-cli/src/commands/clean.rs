@@ -65,8 +65,8 @@ struct TakeArgs {
     /// see bench/results/clean.md for what it gains and costs.
     #[arg(long)]
     despike: bool,
-    /// Only find and bridge spikes (with --despike), no denoising: for takes with little random
-    /// noise, which the shipped model makes worse (see bench/results/clean.md).
+    /// Only find and bridge spikes (with --despike), no denoising: for takes with spikes and little
+    /// random noise, whose spikes the shipped model takes for noise (see bench/results/clean.md).
     #[arg(long, requires = "despike", conflicts_with_all = ["model", "filter"])]
     despike_only: bool,
     /// Spike finding: a boundary is a subtree jump this many times the joints' median jump.
