@@ -45,6 +45,9 @@ if [ "$1" == "--base-input" ]; then
     $BIN/clean_eval --data $DATA --spike-lengths "" --no-filters --no-default-model --max-sigma $sigma "${MODELS[@]}" \
       --json $OUT/eval-base-input-sigma$sigma.json --markdown $OUT/eval-base-input-sigma$sigma.md
   done
+  # Spike finding after it, tuned on 40 validation takes (spans 1-8); "default model" is this model once shipped.
+  $BIN/clean_eval --data $DATA --tune-takes 40 --no-filters --despike --spike-lengths 2,4,8,16,32,64 \
+    --json $OUT/eval-base-input-despike.json --markdown $OUT/eval-base-input-despike.md
   exit 0
 fi
 if [ "$1" == "--despike" ]; then

@@ -51,7 +51,22 @@ pub struct DespikeOptions {
     pub span: usize,
 }
 
+impl DespikeOptions {
+    /// For spike finding after the shipped model: tuned on 40 validation
+    /// takes of the Bandai data with random noise and spikes, on that
+    /// model's output (`bench/clean/wiener.sh --base-input`,
+    /// bench/results/clean.md). The wider span sees the ends of a spike the
+    /// model has blurred.
+    pub fn after_denoising() -> Self {
+        DespikeOptions {
+            span: 3,
+            ..DespikeOptions::default()
+        }
+    }
+}
+
 impl Default for DespikeOptions {
+    /// For spike finding on a take as captured.
     fn default() -> Self {
         // Tuned on 12 validation takes of the Bandai data with random noise
         // and spikes (`mocap clean eval --despike`, bench/results/clean.md).

@@ -261,7 +261,7 @@ fn tune(
 
 /// Spike-finding thresholds and spans tried when tuning.
 const DESPIKE_THRESHOLDS: [f32; 7] = [2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
-const DESPIKE_SPANS: [usize; 3] = [1, 2, 3];
+const DESPIKE_SPANS: [usize; 6] = [1, 2, 3, 4, 6, 8];
 
 /// The spike-finding settings that give the lowest mean rotation error
 /// when run on `cleaner`'s output of the tuning takes (spike condition;

@@ -439,22 +439,29 @@ impl FeatureLayout {
                             decoded.unwrap_or_else(|| relative[p] * motion.local_rotation(f, j));
                         relative[j] = r;
                         if decoded.is_some() {
-                            motion.set_local_rotation(
-                                f,
-                                j,
-                                (relative[p].conjugate() * r).normalize(),
-                            );
+                            let local = (relative[p].conjugate() * r).normalize();
+                            set_rotation_keeping_branch(motion, f, j, local);
                         }
                     }
                     _ => {
                         if let Some(q) = decoded {
-                            motion.set_local_rotation(f, j, q);
+                            set_rotation_keeping_branch(motion, f, j, q);
                         }
                     }
                 }
             }
         }
     }
+}
+
+/// Writes `rotation` as `joint`'s Euler angles in `frame`, choosing of the
+/// equivalent angle triples the one nearest to the angles there before: a
+/// take whose channels use the other Tait-Bryan solution, or angles past
+/// +-180 degrees, keeps them where the rotation barely changed, so the
+/// cleaned file's channels stay comparable to the input's, value by value.
+fn set_rotation_keeping_branch(motion: &mut Motion, frame: usize, joint: usize, rotation: Quat) {
+    let before = motion.rotation_angles(frame, joint);
+    motion.set_local_rotation_near(frame, joint, rotation, Some(before));
 }
 
 /// The other exponential-map vector of the same rotation: `v - 2 pi v/|v|`
@@ -555,6 +562,43 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn decoding_keeps_the_inputs_euler_branch() {
+        use std::f32::consts::PI;
+        // Joint 1's channels on the other Tait-Bryan solution, joint 2's
+        // first angle a whole turn up: the same rotations, other values,
+        // as exporters write them.
+        let mut motion = synthetic_motion(40, 7);
+        for f in 0..motion.frame_count() {
+            let (q1, a1) = (motion.local_rotation(f, 1), motion.rotation_angles(f, 1));
+            let other = Vec3::new(a1.x + PI, PI - a1.y, a1.z + PI);
+            motion.set_local_rotation_near(f, 1, q1, Some(other));
+            let (q2, a2) = (motion.local_rotation(f, 2), motion.rotation_angles(f, 2));
+            let turned = Vec3::new(a2.x + std::f32::consts::TAU, a2.y, a2.z);
+            motion.set_local_rotation_near(f, 2, q2, Some(turned));
+        }
+        assert!(motion.rotation_angles(0, 1).y.abs() > PI / 2.0);
+        for representation in [
+            Representation::Rot6d,
+            Representation::ExpMap,
+            Representation::Euler,
+        ] {
+            let layout = FeatureLayout::new(motion.skeleton(), representation).unwrap();
+            let mut back = motion.clone();
+            layout.decode_into(&layout.encode(&motion), &mut back);
+            let most = motion
+                .values()
+                .iter()
+                .zip(back.values())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f32::max);
+            assert!(
+                most < 0.05,
+                "{representation:?}: a channel moved by {most} degrees"
+            );
         }
     }
 

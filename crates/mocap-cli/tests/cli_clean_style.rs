@@ -143,16 +143,19 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["method"], "spike finding only");
-    // A clean capture has no spikes to bridge: only what spike finding
-    // bridged changes, far less than the shipped model's change.
+    // A clean capture has no spikes to bridge: its channels stay as they
+    // were. So do the shipped model's, nearly: it leaves a take its Wiener
+    // filter finds clean alone, and keeps the input's Euler angles where
+    // the rotation barely changes.
     let despiked = mean_channel_change(Path::new(&input), &output);
+    assert!(despiked < 0.01, "despike only moved channels by {despiked}");
     let modelled = dir.path().join("modelled.bvh");
     let out = mocap(&["clean", &input, "-o", path(&modelled), "--quiet"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let model_change = mean_channel_change(Path::new(&input), &modelled);
     assert!(
-        despiked < 0.25 * model_change,
-        "despike only {despiked} vs model {model_change}"
+        model_change < 0.2,
+        "the model moved channels by {model_change}"
     );
 
     // --despike-only needs --despike, and excludes a model or filter (usage errors).

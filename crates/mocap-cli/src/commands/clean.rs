@@ -72,7 +72,8 @@ struct TakeArgs {
     /// Spike finding: a boundary is a subtree jump this many times the joints' median jump.
     #[arg(long, requires = "despike")]
     despike_threshold: Option<f32>,
-    /// Spike finding: frames averaged on each side of a boundary.
+    /// Spike finding: frames averaged on each side of a boundary (default 3 after cleaning, 2 with
+    /// --despike-only).
     #[arg(long, requires = "despike")]
     despike_span: Option<usize>,
     /// Before cleaning, find spikes (a joint and its subtree taking another motion's rotations) with
@@ -284,7 +285,11 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         (None, None) => Method::DefaultModel,
     };
     let despike = a.despike.then(|| {
-        let mut d = DespikeOptions::default();
+        let mut d = if a.despike_only {
+            DespikeOptions::default()
+        } else {
+            DespikeOptions::after_denoising()
+        };
         set(&mut d.threshold, a.despike_threshold);
         set(&mut d.span, a.despike_span);
         d
