@@ -17,6 +17,10 @@
 //! A last row draws each take's sigma uniformly in [0, 10] degrees, as the
 //! evaluation's spike condition does (`mocap clean eval`).
 //!
+//! The same with the shipped model (the network reading and correcting that
+//! filter) in place of the filter: reading the spikes, after bridging the
+//! true ones, and on the takes without spikes.
+//!
 //! Against: the noisy input, the best fixed Butterworth on the evaluation's
 //! spike condition (2nd order, 2 Hz), the Wiener filter reading the spikes
 //! as they are, and the Wiener filter on the same take without spikes (what
@@ -36,6 +40,7 @@ use mocap_clean::despike::{bridge_spikes, FoundSpike};
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
 use mocap_clean::filters::{filter_motion, Filter};
+use mocap_clean::infer::CleanModel;
 use mocap_clean::noise::{
     add_random_noise, add_random_noise_sigma, add_spike_noise, RandomNoise, Spike, SpikeNoise,
 };
@@ -46,7 +51,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 /// The methods, in table order.
-const METHODS: [&str; 7] = [
+const METHODS: [&str; 10] = [
     "noisy input",
     "butterworth 2 Hz",
     "Wiener filter",
@@ -54,6 +59,9 @@ const METHODS: [&str; 7] = [
     "oracle: bridge, Wiener told the spikes are missing",
     "oracle: bridge, Wiener; spike frames from the rest of the body",
     "Wiener filter, same take without spikes",
+    "shipped model",
+    "oracle: bridge, shipped model",
+    "shipped model, same take without spikes",
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -63,6 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .first()
         .map_or("models/clean-wiener.safetensors", String::as_str);
     let wiener = WienerFilter::load(std::path::Path::new(wiener_path))?;
+    let model = CleanModel::load_default(Default::default())?;
     let all = list_bvh(&[args.data])?;
     let mut takes = load_takes(&paths_in_split(
         &all,
@@ -182,6 +191,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     decoded(&bridged_told),
                     decoded(&combined),
                     decoded(&run(&noisy, false)),
+                    model.clean(&spiked, None).expect("clean"),
+                    model.clean(&bridged, None).expect("clean"),
+                    model.clean(&noisy, None).expect("clean"),
                 ];
                 outputs.map(|out| rotation_error_deg(clean, &out) * n as f64)
             })
