@@ -23,6 +23,9 @@
 //! on the noisy input), its threshold tuned per method the same way (on the
 //! spike condition). Spikes are looked for *after* the method: a denoiser
 //! removes the random noise that hides a spike's ends and leaves the spike.
+//! After a filter they are bridged in its output; after a model, as
+//! `mocap clean --despike` does, in the model's input before it runs again
+//! (the threshold is still tuned by bridging the output).
 
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -37,7 +40,7 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::{
     list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions, Take,
 };
-use crate::despike::{remove_spikes, DespikeOptions};
+use crate::despike::{bridge_spikes, find_spikes, remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
@@ -369,9 +372,19 @@ fn run_methods(
         .collect::<Result<_>>()?;
     for (k, method) in methods.iter().enumerate() {
         let cleaned = method.cleaner.map_or(noisy, |i| &outputs[i]);
-        match &method.despike {
-            Some(d) => take(k, &remove_spikes(cleaned, d).0),
-            None => take(k, cleaned),
+        match (&method.despike, method.cleaner.map(|i| &cleaners[i].1)) {
+            // As `mocap clean --despike` does after a model: the spikes
+            // found in its output bridged in its input, the model run again.
+            (Some(d), Some(model @ Cleaner::Model(_))) => {
+                let found = find_spikes(cleaned, d);
+                if found.is_empty() {
+                    take(k, cleaned)
+                } else {
+                    take(k, &model.run(&bridge_spikes(noisy, &found))?)
+                }
+            }
+            (Some(d), _) => take(k, &remove_spikes(cleaned, d).0),
+            (None, _) => take(k, cleaned),
         }
     }
     Ok(())

@@ -61,8 +61,9 @@ struct TakeArgs {
     /// Frames between window starts (default: a quarter window).
     #[arg(long)]
     hop: Option<usize>,
-    /// After cleaning, find spikes (a joint and its subtree jumping away and back) and bridge them;
-    /// see bench/results/clean.md for what it gains and costs.
+    /// After cleaning, find spikes (a joint and its subtree jumping away and back) and bridge them:
+    /// after a model in its input, which it then cleans again; see bench/results/clean.md for what
+    /// it gains and costs.
     #[arg(long)]
     despike: bool,
     /// Only find and bridge spikes (with --despike), no denoising: for takes with spikes and little
