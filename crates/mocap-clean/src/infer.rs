@@ -107,18 +107,24 @@ impl CleanModel {
         }
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad model description: {e}")))?;
-        let has_base = description.base_filter.is_some() || description.base_wiener.is_some();
+        // Only a Wiener filter estimates the noise level such a network reads.
+        let has_wiener = description.base_wiener.is_some();
         let conditioning = if description.base_input {
             description.network.channels + 1
         } else {
             0
         };
-        if description.network.extra_inputs != conditioning || (description.base_input && !has_base)
+        if description.network.extra_inputs != conditioning
+            || (description.base_input && !has_wiener)
         {
             return Err(bad(format!(
                 "the network reads {} extra inputs, its description asks for {conditioning}{}",
                 description.network.extra_inputs,
-                if has_base { "" } else { " and has no base" }
+                if has_wiener {
+                    ""
+                } else {
+                    " and has no base Wiener filter"
+                }
             )));
         }
         let device = device.device()?;

@@ -89,8 +89,8 @@ pub struct ModelDescription {
     pub base_wiener: Option<WienerDescription>,
     /// The network also reads its base's output and the noise level the
     /// base estimated (degrees over [`NOISE_LEVEL_UNIT_DEG`], constant along
-    /// the window; 0 for a classical base, which estimates none), after the
-    /// noisy features: `network.extra_inputs` is the feature count plus one.
+    /// the window; only a Wiener filter estimates one, so only a model on a
+    /// Wiener filter has this), after the noisy features: `network.extra_inputs` is the feature count plus one.
     /// Without them the network sees only the noisy window, so it cannot
     /// tell what the base (which sees the whole take) already did, nor how
     /// noisy the take is: it then adds a correction of the average noise
@@ -342,7 +342,8 @@ impl<'a> WindowSampler<'a> {
     }
 
     /// Inputs that also hold the base's output and the noise level it
-    /// estimated ([`ModelDescription::base_input`]; needs a base).
+    /// estimated ([`ModelDescription::base_input`]; needs a base, which
+    /// training checks is a Wiener filter).
     pub(crate) fn with_base_input(mut self, on: bool) -> Self {
         self.base_input = on && self.base.is_some();
         self
@@ -536,7 +537,7 @@ pub(crate) fn window_base(
 
 /// The input of a model with [`ModelDescription::base_input`]: every frame's
 /// `channels` noisy features, then the base's output at that frame, then the
-/// noise level (degrees, `None` for a classical base: 0) over
+/// noise level the Wiener filter estimated (degrees; `None` counts as 0) over
 /// [`NOISE_LEVEL_UNIT_DEG`]. Frames by rows, as `window` and `base` are.
 pub(crate) fn with_base_input(
     window: &[f32],
@@ -688,9 +689,11 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             Some(wiener)
         }
     };
-    if options.base_input && !any_base {
+    if options.base_input && options.base_wiener.is_none() {
+        // The correction is scaled by the noise level the base estimates,
+        // and only a Wiener filter estimates one.
         return Err(CleanError::Invalid(
-            "--base-input needs a base filter or a base Wiener filter (its output is the input)"
+            "--base-input needs a base Wiener filter (the noise level it estimates is an input)"
                 .into(),
         ));
     }

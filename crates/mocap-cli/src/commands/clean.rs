@@ -135,9 +135,10 @@ struct TrainArgs {
     /// of a classical --base-filter; the model file then holds both. Use with --base-context.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["base_filter", "spike_detector", "position_weight"])]
     base_wiener: Option<PathBuf>,
-    /// With --base-filter or --base-wiener: the network also reads the filter's output and the noise
-    /// level it estimated, so it can leave a clean take alone (see bench/results/clean.md).
-    #[arg(long, requires = "base")]
+    /// With --base-wiener: the network also reads the filter's output and the noise level it
+    /// estimated, and scales its correction by that level, so it leaves a clean take alone (see
+    /// bench/results/clean.md).
+    #[arg(long, requires = "base_wiener")]
     base_input: bool,
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
