@@ -113,7 +113,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             base_filter: model.description.base_filter,
             base_context: model.description.base_context,
             base_wiener: base_wiener.clone(),
-            base_input: model.description.base_input,
+            base_input: model.description.base_input(),
             epochs: 1,
             steps_per_epoch: train_steps,
             batch_size: batch,

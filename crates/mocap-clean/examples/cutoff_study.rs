@@ -13,7 +13,6 @@
 
 mod support;
 
-use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
 use mocap_clean::filters::{filter_features, gcv_score, gcv_trace_fraction, Filter};
@@ -27,21 +26,11 @@ const CUTOFFS: [f32; 13] = [
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let support::StudyArgs {
-        data,
-        takes: max_takes,
-        sigmas,
-        rest,
-    } = support::parse()?;
-    if let Some(extra) = rest.first() {
+    let args = support::parse()?;
+    if let Some(extra) = args.rest.first() {
         return Err(format!("unexpected argument {extra:?} (DATA [TAKES] [SIGMAS])").into());
     }
-    let paths = paths_in_split(
-        &list_bvh(&[data])?,
-        Split::Validation,
-        &SplitFractions::default(),
-    );
-    let takes = load_takes(&paths[..max_takes.min(paths.len())])?;
+    let takes = args.validation_takes()?;
     println!(
         "{} validation takes; Butterworth order 2; mean rotation error (deg)",
         takes.len()
@@ -51,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         print!(" {c} Hz |");
     }
     println!(" oracle per take | GCV per take | GCV per joint | butterworth-gcv:2 (GCV per channel) | the same on 32-frame windows | oracle per joint | oracle per channel |");
-    for &sigma in &sigmas {
+    for &sigma in &args.sigmas {
         let rows: Vec<Vec<f64>> = takes
             .par_iter()
             .enumerate()

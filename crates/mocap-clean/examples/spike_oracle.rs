@@ -37,9 +37,7 @@ mod support;
 
 use std::time::Instant;
 
-use mocap_clean::dataset::{
-    list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions,
-};
+use mocap_clean::dataset::looped_window;
 use mocap_clean::despike::{bridge_spikes, remove_spikes, DespikeOptions, FoundSpike};
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
@@ -78,13 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map_or("models/clean-wiener.safetensors", String::as_str);
     let wiener = WienerFilter::load(std::path::Path::new(wiener_path))?;
     let model = CleanModel::load_default(Default::default())?;
-    let all = list_bvh(&[args.data])?;
-    let mut takes = load_takes(&paths_in_split(
-        &all,
-        Split::Validation,
-        &SplitFractions::default(),
-    ))?;
-    takes.truncate(args.takes);
+    let takes = args.validation_takes()?;
     let frames: usize = takes.iter().map(|t| t.motion.frame_count()).sum();
     println!(
         "{} validation takes, {frames} frames; random noise of the given sigma, then 1-3 spikes (sd 16 frames) \

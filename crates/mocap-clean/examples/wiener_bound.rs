@@ -29,14 +29,9 @@ use rand::SeedableRng;
 use rayon::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let support::StudyArgs {
-        data,
-        takes: max_takes,
-        sigmas,
-        rest,
-    } = support::parse()?;
-    let segment: usize = rest.first().map_or(Ok(32), |s| s.parse())?;
-    let all = list_bvh(&[data])?;
+    let args = support::parse()?;
+    let segment: usize = args.rest.first().map_or(Ok(32), |s| s.parse())?;
+    let all = list_bvh(std::slice::from_ref(&args.data))?;
     let fractions = SplitFractions::default();
     let train = load_takes(&paths_in_split(&all, Split::Train, &fractions))?;
     let valid = load_takes(&paths_in_split(&all, Split::Validation, &fractions))?;
@@ -74,7 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|t| &t.motion)
         .filter(|m| wiener.clean(m, Some(0.0)).is_ok())
-        .take(max_takes)
+        .take(args.takes)
         .collect();
     println!(
         "{} validation takes; mean rotation error (deg)",
@@ -82,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!("| sigma | input | butterworth-gcv:2 | the same in the noise's eigenbasis | Wiener per channel (true sigma) | multichannel Wiener (true sigma) | multichannel Wiener (estimated sigma) | mean estimated sigma |");
     println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for &sigma in &sigmas {
+    for &sigma in &args.sigmas {
         let rows: Vec<[f64; 7]> = valid
             .par_iter()
             .enumerate()

@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::{
     list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions, Take,
 };
-use crate::despike::{bridge_spikes, find_spikes, remove_spikes, DespikeOptions};
+use crate::despike::{despike_and_rerun, remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
@@ -375,14 +375,10 @@ fn run_methods(
         match (&method.despike, method.cleaner.map(|i| &cleaners[i].1)) {
             // As `mocap clean --despike` does after a model: the spikes
             // found in its output bridged in its input, the model run again.
-            (Some(d), Some(model @ Cleaner::Model(_))) => {
-                let found = find_spikes(cleaned, d);
-                if found.is_empty() {
-                    take(k, cleaned)
-                } else {
-                    take(k, &model.run(&bridge_spikes(noisy, &found))?)
-                }
-            }
+            (Some(d), Some(model @ Cleaner::Model(_))) => take(
+                k,
+                &despike_and_rerun(noisy, cleaned.clone(), d, |bridged| model.run(bridged))?.0,
+            ),
             (Some(d), _) => take(k, &remove_spikes(cleaned, d).0),
             (None, _) => take(k, cleaned),
         }

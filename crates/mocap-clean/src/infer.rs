@@ -24,13 +24,14 @@ use mocap_nn::checkpoint::{header_from_bytes, load_weights_from_bytes};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
-use crate::despike::{bridge_spikes, find_spikes, remove_spikes, DespikeOptions, FoundSpike};
+use crate::despike::{despike_and_rerun, remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::FeatureLayout;
 use crate::filters::{filter_motion, Filter};
 use crate::model::{Denoiser, Head};
 use crate::spikes::{SpikeDetector, SpikeOptions};
 use crate::training::{
-    window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION,
+    base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
+    CHECKPOINT_KIND_VERSION,
 };
 use crate::wiener::{WienerFilter, WIENER_KIND};
 use crate::{CleanError, Result};
@@ -93,37 +94,26 @@ impl CleanModel {
     pub fn from_bytes(bytes: Vec<u8>, origin: &Path, device: DeviceChoice) -> Result<CleanModel> {
         let header = header_from_bytes(&bytes, origin)?;
         let bad = |m: String| CleanError::Invalid(format!("{}: {m}", origin.display()));
-        if header.kind != CHECKPOINT_KIND {
-            return Err(bad(format!(
-                "a `{}` model, expected `{CHECKPOINT_KIND}`",
-                header.kind
-            )));
-        }
-        if header.kind_version != CHECKPOINT_KIND_VERSION {
-            return Err(bad(format!(
-                "model description version {}, this build reads {CHECKPOINT_KIND_VERSION}",
-                header.kind_version
-            )));
-        }
+        header.expect_kind(
+            origin,
+            CHECKPOINT_KIND,
+            CHECKPOINT_KIND_VERSION,
+            "a denoiser",
+        )?;
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad model description: {e}")))?;
-        // Only a Wiener filter estimates the noise level such a network reads.
-        let has_wiener = description.base_wiener.is_some();
-        let conditioning = if description.base_input {
-            description.network.channels + 1
-        } else {
-            0
-        };
-        if description.network.extra_inputs != conditioning
-            || (description.base_input && !has_wiener)
-        {
+        // A network reading more than its features reads its Wiener filter's
+        // output and noise level, and only a Wiener filter estimates one.
+        let extra = description.network.extra_inputs;
+        let expected = base_input_channels(description.network.channels);
+        if extra > 0 && (extra != expected || description.base_wiener.is_none()) {
             return Err(bad(format!(
-                "the network reads {} extra inputs, its description asks for {conditioning}{}",
-                description.network.extra_inputs,
-                if has_wiener {
+                "the network reads {extra} inputs besides its features; a model reading its base \
+                 reads {expected}, and needs a base Wiener filter{}",
+                if description.base_wiener.is_some() {
                     ""
                 } else {
-                    " and has no base Wiener filter"
+                    " (it has none)"
                 }
             )));
         }
@@ -275,7 +265,7 @@ impl CleanModel {
                             .map(|(f, x)| f - x)
                             .collect::<Vec<f32>>(),
                     );
-                    if self.description.base_input {
+                    if self.description.base_input() {
                         w = with_base_input(&w, &filtered, noise_deg.or(window_level), c);
                     }
                 }
@@ -517,21 +507,15 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         }
     };
     let (cleaned, spikes) = match (&options.despike, &model_file) {
-        // Spikes found in a model's output are bridged in its input, and
-        // the model runs again: its Wiener filter then neither smears a
-        // spike into the frames around it nor takes it for noise
-        // (bench/results/clean.md, "Spikes: what finding them could give").
+        // After a model, its spikes are bridged in its input and it runs
+        // again (`despike_and_rerun`).
         (Some(despike), Some(model)) => {
-            let found = find_spikes(&cleaned, despike);
-            if found.is_empty() {
-                (cleaned, found)
-            } else {
-                let start = Instant::now();
-                let bridged = bridge_spikes(&motion, &found);
-                let (again, _) = model.clean(&bridged, options.hop).map_err(in_file)?;
-                seconds += start.elapsed().as_secs_f64();
-                (again, found)
-            }
+            let start = Instant::now();
+            let out = despike_and_rerun(&motion, cleaned, despike, |bridged| {
+                Ok(model.clean(bridged, options.hop).map_err(in_file)?.0)
+            })?;
+            seconds += start.elapsed().as_secs_f64();
+            out
         }
         (Some(despike), None) => remove_spikes(&cleaned, despike),
         (None, _) => (cleaned, Vec::new()),
@@ -555,6 +539,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::despike::bridge_spikes;
     use crate::features::Representation;
     use crate::model::DenoiserConfig;
     use crate::test_support::synthetic_motion;
@@ -575,7 +560,6 @@ mod tests {
             base_filter: None,
             base_context: 0,
             base_wiener: None,
-            base_input: false,
         };
         description_bytes(&model, &description)
     }
@@ -614,7 +598,6 @@ mod tests {
             base_filter: Some(filter),
             base_context: 64,
             base_wiener: None,
-            base_input: false,
         };
         let clean = crate::test_support::synthetic_motion_phase(150, joints, 0.3);
         let noise = crate::noise::RandomNoise::default();
@@ -764,12 +747,15 @@ mod tests {
             }
         };
         let mut description = a.description.clone();
-        description.base_input = true;
+        description.network.extra_inputs = description.network.channels + 1;
         let e = refused(&description);
-        assert!(e.contains("extra inputs") && e.contains("no base"), "{e}");
+        assert!(
+            e.contains("needs a base Wiener filter (it has none)"),
+            "{e}"
+        );
         description.base_filter = Some(Filter::ButterworthGcv { order: 2 });
         description.network.extra_inputs = 1;
         let e = refused(&description);
-        assert!(e.contains("reads 1 extra inputs"), "{e}");
+        assert!(e.contains("reads 1 inputs besides its features"), "{e}");
     }
 }

@@ -16,6 +16,11 @@
 //! the network predict a correction to its input, which is small for random
 //! noise. Every skip connection adds tensors of the same size.
 //!
+//! A denoiser may read more than it outputs ([`DenoiserConfig::extra_inputs`]:
+//! the base filter's output and, last, the noise level that filter
+//! estimated). Its correction is then multiplied by that last input, so it
+//! vanishes on a take the filter found clean.
+//!
 //! The same network with another head ([`Head::SpikeLogits`]: one output per
 //! joint, no global skip) is the learned spike detector of
 //! [`crate::spikes`]: for every joint and frame, the logit of "this joint's
@@ -52,16 +57,11 @@ pub struct DenoiserConfig {
     pub head: Head,
     /// Input channels after the `channels` features that the network reads
     /// but does not output or add to its output: what it is conditioned on
-    /// ([`crate::training::ModelDescription::base_input`]). 0 for models
-    /// written before this field.
+    /// ([`crate::training::TrainOptions::base_input`]). The last of them is a
+    /// noise level, and the correction is multiplied by it (see the module
+    /// docs). 0 for models written before this field.
     #[serde(default)]
     pub extra_inputs: usize,
-    /// The correction is the output layer's times the last input channel
-    /// (the noise level, [`crate::training::ModelDescription::base_input`]),
-    /// so that it vanishes on a take the base found clean. `false` for
-    /// models written before this field.
-    #[serde(default)]
-    pub level_gate: bool,
 }
 
 /// What the network outputs.
@@ -87,7 +87,6 @@ impl DenoiserConfig {
             window: 16,
             head: Head::Correction,
             extra_inputs: 0,
-            level_gate: false,
         }
     }
 
@@ -102,7 +101,6 @@ impl DenoiserConfig {
             window: 16,
             head: Head::Correction,
             extra_inputs: 0,
-            level_gate: false,
         }
     }
 
@@ -118,8 +116,8 @@ impl DenoiserConfig {
         if self.head == (Head::SpikeLogits { joints: 0 }) {
             return bad("a spike detector needs at least one joint");
         }
-        if self.level_gate && (self.extra_inputs == 0 || self.head != Head::Correction) {
-            return bad("a level gate needs a denoiser with a noise-level input");
+        if self.extra_inputs > 0 && self.head != Head::Correction {
+            return bad("only a denoiser reads inputs it does not output");
         }
         if self.levels > 6 || self.window == 0 || !self.window.is_multiple_of(1 << self.levels) {
             return bad("the window must be a positive multiple of 2^levels (levels at most 6)");
@@ -188,7 +186,6 @@ impl DenoiserConfig {
             output: conv(self.width, self.output_channels()),
             residual: self.head == Head::Correction,
             features: self.channels,
-            level_gate: self.level_gate,
             base: None,
         })
     }
@@ -250,9 +247,6 @@ pub struct Denoiser {
     /// the network): the global skip adds those. Not a weight.
     #[module(skip)]
     features: usize,
-    /// See [`DenoiserConfig::level_gate`]. Not a weight.
-    #[module(skip)]
-    level_gate: bool,
     /// The learned Wiener filter the network corrects, when it does
     /// ([`crate::training::ModelDescription::base_wiener`]): not trained and
     /// not used by `forward`; it rides along so that one file holds the
@@ -285,8 +279,9 @@ impl Denoiser {
             }
         }
         let mut out = self.output.forward(h);
-        if self.level_gate {
-            let inputs = x.dims()[1];
+        let inputs = x.dims()[1];
+        if inputs > self.features {
+            // The last input is the noise level: the correction scales with it.
             out = out * x.clone().narrow(1, inputs - 1, 1);
         }
         if self.residual {
@@ -360,11 +355,10 @@ mod tests {
     }
 
     #[test]
-    fn a_level_gate_scales_the_correction_by_the_last_input() {
+    fn extra_inputs_scale_the_correction_by_the_last_one() {
         let device = Device::flex();
         let config = DenoiserConfig {
             extra_inputs: 2,
-            level_gate: true,
             ..DenoiserConfig::small(4)
         };
         let model = config.init(&device).unwrap();
@@ -394,11 +388,11 @@ mod tests {
         let size = |v: Vec<f32>| v.iter().map(|x| x.abs()).sum::<f32>();
         assert!(size(correction(0.5)) > 0.0);
         assert!(size(correction(0.01)) < 0.1 * size(correction(0.5)));
-        let bad = DenoiserConfig {
-            level_gate: true,
-            ..DenoiserConfig::small(4)
+        let spike_detector = DenoiserConfig {
+            head: Head::SpikeLogits { joints: 2 },
+            ..config
         };
-        assert!(bad.validate().is_err());
+        assert!(spike_detector.validate().is_err());
     }
 
     #[test]

@@ -87,27 +87,25 @@ pub struct ModelDescription {
     /// network's weights.
     #[serde(default)]
     pub base_wiener: Option<WienerDescription>,
-    /// The network also reads its base's output and the noise level the
-    /// base estimated (degrees over [`NOISE_LEVEL_UNIT_DEG`], constant along
-    /// the window; only a Wiener filter estimates one, so only a model on a
-    /// Wiener filter has this), after the noisy features: `network.extra_inputs` is the feature count plus one.
-    /// Without them the network sees only the noisy window, so it cannot
-    /// tell what the base (which sees the whole take) already did, nor how
-    /// noisy the take is: it then adds a correction of the average noise
-    /// level to a clean take too (measured: 0.81 degrees on clean test takes
-    /// for the model shipped in session 7). A noise-level input is how
-    /// FFDNet (Zhang, Zuo and Zhang 2018) makes one denoiser serve every
-    /// noise level. The input alone did not stop that (0.85 degrees on 40
-    /// clean test takes after 4 epochs), so such a model also multiplies its
-    /// correction by the level ([`DenoiserConfig::level_gate`]): where the
-    /// base finds no noise, it leaves the base's output, which is then the
-    /// take itself. `false` for models written before this field.
-    #[serde(default)]
-    pub base_input: bool,
+}
+
+impl ModelDescription {
+    /// Whether the network also reads its Wiener filter's output and noise
+    /// level ([`TrainOptions::base_input`]): it has inputs beyond the
+    /// features.
+    pub fn base_input(&self) -> bool {
+        self.network.extra_inputs > 0
+    }
+}
+
+/// The inputs a network reading its base adds to `features` channels: the
+/// base's output, then the noise level ([`TrainOptions::base_input`]).
+pub(crate) fn base_input_channels(features: usize) -> usize {
+    features + 1
 }
 
 /// The unit of the noise-level input of a model with
-/// [`ModelDescription::base_input`]: the report's largest noise, so that the
+/// [`TrainOptions::base_input`]: the report's largest noise, so that the
 /// input is about 0 to 1.
 pub const NOISE_LEVEL_UNIT_DEG: f64 = 10.0;
 
@@ -174,7 +172,22 @@ pub struct TrainOptions {
     /// [`ModelDescription::base_wiener`]).
     #[serde(default)]
     pub base_wiener: Option<PathBuf>,
-    /// See [`ModelDescription::base_input`].
+    /// The network also reads its Wiener filter's output and the noise level
+    /// the filter estimated (degrees over [`NOISE_LEVEL_UNIT_DEG`], constant
+    /// along the window; only a Wiener filter estimates one, so this needs
+    /// `base_wiener`), after the noisy features, and its correction is
+    /// multiplied by that level (see [`crate::model`]).
+    ///
+    /// Without them the network sees only the noisy window, so it cannot
+    /// tell what the filter (which sees the whole take) already did, nor how
+    /// noisy the take is: it then adds a correction of the average noise
+    /// level to a clean take too (measured: 0.81 degrees on clean test takes
+    /// for the model shipped in session 7). A noise-level input is how
+    /// FFDNet (Zhang, Zuo and Zhang 2018) makes one denoiser serve every
+    /// noise level. The inputs alone did not stop that (0.85 degrees on 40
+    /// clean test takes after 4 epochs), hence the scaling: where the filter
+    /// finds no noise the model gives the filter's output, which is then the
+    /// take itself.
     #[serde(default)]
     pub base_input: bool,
     /// Network sizes; `channels` is set from the data.
@@ -284,7 +297,7 @@ pub struct WindowSampler<'a> {
     /// the clean features.
     spike_targets: bool,
     /// The input also holds the base's output and noise level
-    /// ([`ModelDescription::base_input`]).
+    /// ([`TrainOptions::base_input`]).
     base_input: bool,
 }
 
@@ -342,19 +355,19 @@ impl<'a> WindowSampler<'a> {
     }
 
     /// Inputs that also hold the base's output and the noise level it
-    /// estimated ([`ModelDescription::base_input`]; needs a base, which
-    /// training checks is a Wiener filter).
+    /// estimated ([`TrainOptions::base_input`]; needs a base, which training
+    /// checks is a Wiener filter).
     pub(crate) fn with_base_input(mut self, on: bool) -> Self {
         self.base_input = on && self.base.is_some();
         self
     }
 
     /// Rows of an input window: the features, then with
-    /// [`ModelDescription::base_input`] the base's output and the noise level.
+    /// [`TrainOptions::base_input`] the base's output and the noise level.
     pub fn input_channels(&self) -> usize {
         let c = self.layout.channels();
         if self.base_input {
-            2 * c + 1
+            c + base_input_channels(c)
         } else {
             c
         }
@@ -535,7 +548,7 @@ pub(crate) fn window_base(
     }
 }
 
-/// The input of a model with [`ModelDescription::base_input`]: every frame's
+/// The input of a model with [`TrainOptions::base_input`]: every frame's
 /// `channels` noisy features, then the base's output at that frame, then the
 /// noise level the Wiener filter estimated (degrees; `None` counts as 0) over
 /// [`NOISE_LEVEL_UNIT_DEG`]. Frames by rows, as `window` and `base` are.
@@ -700,11 +713,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     // What the network reads besides the features follows from the options
     // alone (a configuration copied from another model may say otherwise).
     network.extra_inputs = if options.base_input {
-        layout.channels() + 1
+        base_input_channels(layout.channels())
     } else {
         0
     };
-    network.level_gate = options.base_input;
     if options.base_context > 0 && !any_base {
         return Err(CleanError::Invalid(
             "a base context needs a base filter (the context is what that filter sees)".into(),
@@ -719,7 +731,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         base_filter: options.base_filter,
         base_context: options.base_context,
         base_wiener: base_wiener.as_ref().map(|w| w.description.clone()),
-        base_input: options.base_input,
     };
     let base = Base::of(options.base_filter, fps, base_wiener.as_ref());
     let loss = if options.derivative_loss {
@@ -981,7 +992,6 @@ mod tests {
                 window: 8,
                 head: Head::Correction,
                 extra_inputs: 0,
-                level_gate: false,
             },
             epochs: 2,
             steps_per_epoch: 2,
@@ -1319,7 +1329,7 @@ mod tests {
         let report = train(&options).unwrap();
         let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
         let c = model.description.network.channels;
-        assert!(model.description.base_input);
+        assert!(model.description.base_input());
         assert_eq!(model.description.network.input_channels(), 2 * c + 1);
 
         // The training windows: features, the filter's output, the level.

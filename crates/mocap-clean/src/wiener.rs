@@ -156,6 +156,13 @@ pub struct WienerOutcome {
     pub sigma_deg: f64,
 }
 
+/// A joint's 6 features have 3 degrees of freedom, so `N` is singular: a
+/// ridge of 1e-6 of its mean variance stands for the directions with
+/// (almost) no noise, which the filter then passes through.
+fn noise_ridge(noise: &DMatrix<f64>) -> f64 {
+    1e-6 * noise.trace() / noise.nrows().max(1) as f64 + 1e-12
+}
+
 /// Periodic Hann window of `len` frames at `t`.
 fn hann(t: usize, len: usize) -> f64 {
     0.5 - 0.5 * (2.0 * PI * t as f64 / len as f64).cos()
@@ -386,10 +393,7 @@ impl WienerFilter {
         noise: DMatrix<f64>,
     ) -> WienerFilter {
         let c = noise.nrows();
-        // A joint's 6 features have 3 degrees of freedom, so N is singular:
-        // a ridge of 1e-6 of its mean variance stands for the directions
-        // with (almost) no noise, which the filter then passes through.
-        let ridge = 1e-6 * noise.trace() / c as f64 + 1e-12;
+        let ridge = noise_ridge(&noise);
         // N = Q D Q^T once: its powers with the ridge for (1), and the
         // directions it puts noise in for (2).
         let eigen = SymmetricEigen::new(noise.clone());
@@ -549,6 +553,12 @@ impl WienerFilter {
         });
         let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
         let padded_missing = missing.map(|m| reflect_pad(&m[..frames * c], c, len));
+        // For (3): S(f) + s N per bin, the same for every segment.
+        let totals: Vec<DMatrix<C64>> = if padded_missing.is_some() {
+            self.signal_plus_noise(s)
+        } else {
+            Vec::new()
+        };
         // (1) per segment and bin: whiten (z = V^H N^-1/2 X), scale each
         // coordinate by lambda / (lambda + s), colour back.
         let filtered: Vec<Vec<f64>> = starts
@@ -561,7 +571,7 @@ impl WienerFilter {
                         .collect()
                 });
                 if !gone.is_empty() {
-                    return transforms.inverse_segment(&self.conditional_mean(x, s, &gone));
+                    return transforms.inverse_segment(&self.conditional_mean(x, &totals, &gone));
                 }
                 let mut spectrum = DMatrix::<C64>::zeros(c, self.bins.len());
                 for (b, bin) in self.bins.iter().enumerate() {
@@ -593,22 +603,42 @@ impl WienerFilter {
         WienerOutcome { sigma_deg: sigma }
     }
 
-    /// (3) for one segment's bins `x` (`c x bins`) at noise level `s`, the
-    /// channels `gone` not read.
-    fn conditional_mean(&self, x: &DMatrix<C64>, s: f64, gone: &[usize]) -> DMatrix<C64> {
+    /// `S(f) + s (N + ridge)` for every bin: the covariance of a noisy
+    /// segment's bins at noise level `s`.
+    fn signal_plus_noise(&self, s: f64) -> Vec<DMatrix<C64>> {
         let c = self.description.channels;
-        let ridge = 1e-6 * self.noise.trace() / c as f64 + 1e-12;
+        let ridge = noise_ridge(&self.noise);
+        self.spectra
+            .iter()
+            .map(|spectrum| {
+                let mut total = spectrum.clone();
+                for i in 0..c {
+                    for j in 0..c {
+                        total[(i, j)] += C64::new(s * self.noise[(i, j)], 0.0);
+                    }
+                    total[(i, i)] += C64::new(s * ridge, 0.0);
+                }
+                total
+            })
+            .collect()
+    }
+
+    /// (3) for one segment's bins `x` (`c x bins`), `totals` being
+    /// [`WienerFilter::signal_plus_noise`] at the take's level, the channels
+    /// `gone` not read.
+    fn conditional_mean(
+        &self,
+        x: &DMatrix<C64>,
+        totals: &[DMatrix<C64>],
+        gone: &[usize],
+    ) -> DMatrix<C64> {
+        let c = self.description.channels;
+        let ridge = noise_ridge(&self.noise);
         let mut out = DMatrix::<C64>::zeros(c, self.bins.len());
-        for (b, spectrum) in self.spectra.iter().enumerate() {
+        for (b, (spectrum, total)) in self.spectra.iter().zip(totals).enumerate() {
             // Far above any channel's power: the channel's value is noise.
             let unknown = 1e6 * (spectrum.trace().re / c as f64 + ridge);
-            let mut total = spectrum.clone();
-            for i in 0..c {
-                for j in 0..c {
-                    total[(i, j)] += C64::new(s * self.noise[(i, j)], 0.0);
-                }
-                total[(i, i)] += C64::new(s * ridge, 0.0);
-            }
+            let mut total = total.clone();
             for &k in gone {
                 total[(k, k)] += C64::new(unknown, 0.0);
             }
@@ -786,18 +816,7 @@ impl WienerFilter {
     pub fn from_bytes(bytes: Vec<u8>, origin: &Path) -> Result<WienerFilter> {
         let header = header_from_bytes(&bytes, origin)?;
         let bad = |m: String| CleanError::Invalid(format!("{}: {m}", origin.display()));
-        if header.kind != WIENER_KIND {
-            return Err(bad(format!(
-                "a `{}` file, expected `{WIENER_KIND}`",
-                header.kind
-            )));
-        }
-        if header.kind_version != WIENER_KIND_VERSION {
-            return Err(bad(format!(
-                "Wiener filter version {}, this build reads {WIENER_KIND_VERSION}",
-                header.kind_version
-            )));
-        }
+        header.expect_kind(origin, WIENER_KIND, WIENER_KIND_VERSION, "a Wiener filter")?;
         let description: WienerDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad Wiener filter description: {e}")))?;
         Self::check_description(&description).map_err(bad)?;

@@ -53,6 +53,30 @@ pub struct CheckpointHeader {
     pub training: serde_json::Value,
 }
 
+impl CheckpointHeader {
+    /// Checks that the file holds `what` (kind `kind`, configuration layout
+    /// `version`); the error names `origin`, the kind found and the one
+    /// expected.
+    pub fn expect_kind(&self, origin: &Path, kind: &str, version: u32, what: &str) -> Result<()> {
+        if self.kind != kind {
+            return Err(checkpoint_error(
+                origin,
+                format!("a `{}` file, not {what} (`{kind}`)", self.kind),
+            ));
+        }
+        if self.kind_version != version {
+            return Err(checkpoint_error(
+                origin,
+                format!(
+                    "{what} version {}, this build reads version {version}",
+                    self.kind_version
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 fn checkpoint_error(path: &Path, message: impl Into<String>) -> NnError {
     NnError::Checkpoint {
         path: path.to_path_buf(),
@@ -293,4 +317,40 @@ pub fn save_epoch<M: Module>(
         &crate::plot::history_series(history, ""),
         plot_options,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_header_of_another_kind_or_version_is_refused_by_name() {
+        let header = CheckpointHeader {
+            kind: "mocap-clean/wiener".into(),
+            kind_version: 1,
+            config: serde_json::Value::Null,
+            data: serde_json::Value::Null,
+            training: serde_json::Value::Null,
+        };
+        let origin = Path::new("models/m.safetensors");
+        header
+            .expect_kind(origin, "mocap-clean/wiener", 1, "a Wiener filter")
+            .unwrap();
+        let other = header
+            .expect_kind(origin, "mocap-clean/denoiser", 1, "a denoiser")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            other,
+            "models/m.safetensors: a `mocap-clean/wiener` file, not a denoiser (`mocap-clean/denoiser`)"
+        );
+        let newer = header
+            .expect_kind(origin, "mocap-clean/wiener", 2, "a Wiener filter")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            newer.contains("a Wiener filter version 1, this build reads version 2"),
+            "{newer}"
+        );
+    }
 }

@@ -168,20 +168,12 @@ impl StyleModel {
     /// Loads checkpoint bytes; `origin` names them in errors.
     pub fn from_bytes(bytes: Vec<u8>, origin: &Path, device: DeviceChoice) -> Result<StyleModel> {
         let header = header_from_bytes(&bytes, origin)?;
-        if header.kind != CHECKPOINT_KIND {
-            return Err(invalid(format!(
-                "{}: a `{}` model, not a style autoencoder ({CHECKPOINT_KIND})",
-                origin.display(),
-                header.kind
-            )));
-        }
-        if header.kind_version != CHECKPOINT_KIND_VERSION {
-            return Err(invalid(format!(
-                "{}: style model version {}, this build reads version {CHECKPOINT_KIND_VERSION}",
-                origin.display(),
-                header.kind_version
-            )));
-        }
+        header.expect_kind(
+            origin,
+            CHECKPOINT_KIND,
+            CHECKPOINT_KIND_VERSION,
+            "a style autoencoder",
+        )?;
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| invalid(format!("{}: bad model description: {e}", origin.display())))?;
         let device = device.device()?;

@@ -3,6 +3,8 @@
 use std::error::Error;
 use std::path::PathBuf;
 
+use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions, Take};
+
 /// Parsed study arguments.
 pub struct StudyArgs {
     /// The folder of clean takes.
@@ -31,4 +33,18 @@ pub fn parse() -> Result<StudyArgs, Box<dyn Error>> {
         sigmas,
         rest: args.iter().skip(3).cloned().collect(),
     })
+}
+
+impl StudyArgs {
+    /// The first `takes` validation takes of `data` (the training code's
+    /// split by take).
+    #[allow(dead_code)] // not every study reads only validation takes
+    pub fn validation_takes(&self) -> Result<Vec<Take>, Box<dyn Error>> {
+        let paths = paths_in_split(
+            &list_bvh(std::slice::from_ref(&self.data))?,
+            Split::Validation,
+            &SplitFractions::default(),
+        );
+        Ok(load_takes(&paths[..self.takes.min(paths.len())])?)
+    }
 }
