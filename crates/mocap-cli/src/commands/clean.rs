@@ -159,7 +159,7 @@ struct TrainArgs {
     #[arg(long)]
     window: Option<usize>,
     /// Largest standard deviation of the random noise, degrees (report: 10).
-    #[arg(long)]
+    #[arg(long, value_name = "MAX", value_parser = degrees_at_least_zero)]
     max_sigma: Option<f32>,
     /// Also put random noise on the joints above the pelvis (helper joints such as Bandai's
     /// `joint_Root` on the floor; off by default, see bench/results/clean.md).
