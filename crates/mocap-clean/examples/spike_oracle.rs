@@ -21,9 +21,11 @@
 //! filter) in place of the filter: reading the spikes, after bridging the
 //! true ones, and on the takes without spikes.
 //!
-//! Last, not an oracle: the spikes that spike finding finds in the shipped
-//! model's output (`mocap clean --despike`) bridged in that output, or
-//! bridged in the input before the model runs again.
+//! Last, not an oracle: spike finding as sessions 4-8 ran it (on local
+//! rotations, in the shipped model's output) bridged in that output, or in
+//! the input before the model runs again; and as `mocap clean --despike`
+//! runs it now (on global rotations, in the input, before the model, or
+//! before the Butterworth filter).
 //!
 //! Against: the noisy input, the best fixed Butterworth on the evaluation's
 //! spike condition (2nd order, 2 Hz), the Wiener filter reading the spikes
@@ -53,7 +55,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 /// The methods, in table order.
-const METHODS: [&str; 12] = [
+const METHODS: [&str; 14] = [
     "noisy input",
     "butterworth 2 Hz",
     "Wiener filter",
@@ -64,8 +66,10 @@ const METHODS: [&str; 12] = [
     "shipped model",
     "oracle: bridge, shipped model",
     "shipped model, same take without spikes",
-    "shipped model, spikes found in its output bridged there",
-    "shipped model, spikes found in its output bridged in the input, shipped model again",
+    "shipped model, spikes found in its output (local rotations) bridged there",
+    "shipped model, spikes found in its output (local rotations) bridged in the input, shipped model again",
+    "spikes found in the input (global rotations, --despike) bridged, then the shipped model",
+    "spikes found in the input (global rotations, --despike) bridged, then butterworth 2 Hz",
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -177,10 +181,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 // Not an oracle: spike finding on the model's output
                 // (`mocap clean --despike`), its spikes bridged in that
                 // output, or in the input before cleaning it again.
-                let (found_bridged_after, found_after) = remove_spikes(
-                    &model.clean(&spiked, None).expect("clean"),
-                    &DespikeOptions::after_denoising(),
-                );
+                let on_output = DespikeOptions {
+                    threshold: 3.0,
+                    span: 3,
+                    global: false,
+                    ..DespikeOptions::default()
+                };
+                let (found_bridged_after, found_after) =
+                    remove_spikes(&model.clean(&spiked, None).expect("clean"), &on_output);
+                let (despiked, _) = remove_spikes(&spiked, &DespikeOptions::default());
                 let outputs = [
                     spiked.clone(),
                     filter_motion(
@@ -203,6 +212,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     model
                         .clean(&bridge_spikes(&spiked, &found_after), None)
                         .expect("clean"),
+                    model.clean(&despiked, None).expect("clean"),
+                    filter_motion(
+                        &despiked,
+                        &Filter::Butterworth {
+                            order: 2,
+                            cutoff_hz: 2.0,
+                        },
+                    )
+                    .expect("filter"),
                 ];
                 outputs.map(|out| rotation_error_deg(clean, &out) * n as f64)
             })

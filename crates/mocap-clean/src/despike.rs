@@ -1,4 +1,4 @@
-//! Finding and bridging spikes by hand-written rules: a classical stage, run alone or after a denoiser.
+//! Finding and bridging spikes by hand-written rules: a classical stage, run alone or before a filter or denoiser.
 //!
 //! A spike of markerless capture (a wrong association with another person,
 //! [`crate::noise::SpikeNoise`]) gives a joint and every joint below it the
@@ -7,15 +7,16 @@
 //! it from the truth once the spike is longer than its window; what gives a
 //! spike away is its two ends, where the whole subtree jumps at once.
 //!
-//! [`find_spikes`] looks for those jumps:
+//! [`find_spikes`] looks for those jumps in the take as captured:
 //!
-//! 1. the jump of joint `k` at frame `t` is the angle between its mean local
+//! 1. the jump of joint `k` at frame `t` is the angle between its mean
 //!    rotation over the [`DespikeOptions::span`] frames before `t` and over
 //!    the `span` frames from `t` on (with a span of 1: frames `t - 1` and
-//!    `t`; longer spans average out per-frame noise and see the ends of a
-//!    spike that a denoiser has blurred), divided by the upper quartile of that
-//!    joint's jumps over the take (so fast joints and noisy takes are judged by
-//!    their own scale);
+//!    `t`), divided by the upper quartile of that joint's jumps over the take
+//!    (so fast joints and noisy takes are judged by their own scale). The
+//!    rotation is the joint's global one by default
+//!    ([`DespikeOptions::global`]): IK noise swings local rotations far more
+//!    than global ones, a spike turns its subtree in both;
 //! 2. the jump of a subtree is the median of its joints' jumps: a spike
 //!    moves (nearly) all of them at once, a noisy joint alone does not;
 //! 3. a joint whose own jump and whose subtree's jump both exceed
@@ -27,53 +28,55 @@
 //! 4. boundaries of the same joint are paired in time order, the first
 //!    opening and the second closing a spike, when they lie at most
 //!    [`DespikeOptions::max_frames`] apart (intermittent spikes give several
-//!    pairs); a boundary without a partner is left alone.
+//!    pairs), and a spike inside a spike of a joint above it is bridged with
+//!    that one; a boundary without a partner is left alone (taking it for a
+//!    spike running to the nearer end of the take was measured worse:
+//!    bench/results/clean.md).
 //!
 //! [`remove_spikes`] then replaces each found spike's subtree rotations by
 //! the spherical interpolation (slerp) between the last frame before and the
 //! first frame after it. Long spikes are bridged with a straight path, which
 //! loses whatever the joint really did meanwhile, but it is much closer than
 //! another person's motion.
+//! `mocap clean --despike` does this before a filter or a denoiser runs,
+//! which would smear each spike's jumps over the frames around it and take
+//! part of it for noise (bench/results/clean.md).
 
 use mocap_core::rotation::{angle_between, slerp, Quat};
-use mocap_core::Motion;
+use mocap_core::{forward_kinematics, Motion};
 use serde::{Deserialize, Serialize};
 
 /// Settings of spike finding.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DespikeOptions {
-    /// A subtree's median jump, in multiples of each joint's median jump,
-    /// above which a frame is a spike boundary.
+    /// A subtree's median jump, in multiples of each joint's upper-quartile
+    /// jump, above which a frame is a spike boundary.
     pub threshold: f32,
     /// Longest spike looked for, in frames.
     pub max_frames: usize,
     /// Frames averaged on each side of a boundary (at least 1).
     pub span: usize,
-}
-
-impl DespikeOptions {
-    /// For spike finding after the shipped model: tuned on 40 validation
-    /// takes of the Bandai data with random noise and spikes, on that
-    /// model's output (`bench/clean/wiener.sh --base-input`,
-    /// bench/results/clean.md). The wider span sees the ends of a spike the
-    /// model has blurred.
-    pub fn after_denoising() -> Self {
-        DespikeOptions {
-            span: 3,
-            ..DespikeOptions::default()
-        }
-    }
+    /// Jumps of global rotations (forward kinematics) instead of local ones.
+    /// Noise of IK on keypoints errs on the local rotations by several times
+    /// its level (a joint swings to keep its child near the keypoint,
+    /// [`crate::noise`]) but on the global ones by about its level, while a
+    /// spike turns its whole subtree in both: spike boundaries stand out far
+    /// better in global rotations (bench/results/clean.md).
+    #[serde(default)]
+    pub global: bool,
 }
 
 impl Default for DespikeOptions {
-    /// For spike finding on a take as captured.
+    /// Tuned on the 120 validation takes of the Bandai data with random
+    /// noise and spikes, the spikes bridged before the shipped model
+    /// (`mocap clean eval --despike`, bench/results/clean.md); the same
+    /// settings are tuned for spike finding alone.
     fn default() -> Self {
-        // Tuned on 12 validation takes of the Bandai data with random noise
-        // and spikes (`mocap clean eval --despike`, bench/results/clean.md).
         DespikeOptions {
             threshold: 3.0,
             max_frames: 90,
-            span: 2,
+            span: 1,
+            global: true,
         }
     }
 }
@@ -116,29 +119,7 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
         .iter()
         .map(|j| j.has_rotation_channels())
         .collect();
-    // Jumps, in multiples of each joint's median jump; jump[t * n + k] is
-    // between frames t - 1 and t (t < first unused).
-    let mut jump = vec![0.0f32; frames * n];
-    for k in (0..n).filter(|&k| rotates[k]) {
-        let mut angles: Vec<f32> = (first..=last)
-            .map(|t| {
-                let before = mean_rotation((t - span..t).map(|f| motion.local_rotation(f, k)));
-                let after = mean_rotation((t..t + span).map(|f| motion.local_rotation(f, k)));
-                angle_between(before, after).to_degrees()
-            })
-            .collect();
-        for (i, a) in angles.iter().enumerate() {
-            jump[(first + i) * n + k] = *a;
-        }
-        // The scale: the upper quartile of the joint's jumps (at least one
-        // degree). Not the median: joints that rest most of the time (toes
-        // in a walk) would make every step look like a spike.
-        angles.sort_by(f32::total_cmp);
-        let scale = angles[angles.len() * 3 / 4].max(1.0);
-        for t in first..=last {
-            jump[t * n + k] /= scale;
-        }
-    }
+    let jump = normalised_jumps(motion, span, options.global);
     let subtrees: Vec<Vec<usize>> = (0..n)
         .map(|j| {
             skeleton
@@ -230,7 +211,65 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
             }
         }
     }
+    // A spike inside a spike of a joint above it is bridged with it.
+    let inside_above = |s: &FoundSpike| {
+        spikes.iter().any(|a| {
+            a.joint != s.joint
+                && skeleton.subtree(a.joint).contains(&s.joint)
+                && a.start <= s.start
+                && s.start + s.frames <= a.start + a.frames
+        })
+    };
     spikes
+        .iter()
+        .filter(|s| !inside_above(s))
+        .copied()
+        .collect()
+}
+
+/// Step 1 of [`find_spikes`]: `jump[t * joints + k]`, the angle (degrees)
+/// between joint `k`'s mean rotation (global with `global`, from forward
+/// kinematics, else local) over the `span` frames before
+/// frame `t` and over the `span` frames from `t` on, divided by the upper
+/// quartile of that joint's jumps over the take (at least one degree); zero
+/// where a side has fewer than `span` frames and for joints without rotation
+/// channels.
+pub fn normalised_jumps(motion: &Motion, span: usize, global: bool) -> Vec<f32> {
+    let skeleton = motion.skeleton();
+    let frames = motion.frame_count();
+    let n = skeleton.joint_count();
+    let span = span.max(1);
+    let mut jump = vec![0.0f32; frames * n];
+    if frames < 2 * span + 1 {
+        return jump;
+    }
+    let (first, last) = (span, frames - span);
+    let poses = global.then(|| forward_kinematics(motion));
+    let rotation = |f: usize, k: usize| match &poses {
+        Some(poses) => poses.rotation(f, k),
+        None => motion.local_rotation(f, k),
+    };
+    for k in (0..n).filter(|&k| skeleton.joint(k).has_rotation_channels()) {
+        let mut angles: Vec<f32> = (first..=last)
+            .map(|t| {
+                let before = mean_rotation((t - span..t).map(|f| rotation(f, k)));
+                let after = mean_rotation((t..t + span).map(|f| rotation(f, k)));
+                angle_between(before, after).to_degrees()
+            })
+            .collect();
+        for (i, a) in angles.iter().enumerate() {
+            jump[(first + i) * n + k] = *a;
+        }
+        // The scale: the upper quartile of the joint's jumps (at least one
+        // degree). Not the median: joints that rest most of the time (toes
+        // in a walk) would make every step look like a spike.
+        angles.sort_by(f32::total_cmp);
+        let scale = angles[angles.len() * 3 / 4].max(1.0);
+        for t in first..=last {
+            jump[t * n + k] /= scale;
+        }
+    }
+    jump
 }
 
 /// `motion` with every found spike bridged by slerp (see the module docs),
@@ -238,25 +277,6 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
 pub fn remove_spikes(motion: &Motion, options: &DespikeOptions) -> (Motion, Vec<FoundSpike>) {
     let spikes = find_spikes(motion, options);
     (bridge_spikes(motion, &spikes), spikes)
-}
-
-/// Spike finding after a denoiser that can run again: the spikes found in
-/// its output `cleaned` are bridged in its input `noisy`, and `rerun` cleans
-/// that instead; with no spike found `cleaned` is kept. The denoiser's
-/// filter then neither smears a spike into the frames around it nor takes
-/// it for noise, which beats bridging the output (bench/results/clean.md,
-/// "Spikes: what finding them could give").
-pub fn despike_and_rerun(
-    noisy: &Motion,
-    cleaned: Motion,
-    options: &DespikeOptions,
-    rerun: impl FnOnce(&Motion) -> crate::Result<Motion>,
-) -> crate::Result<(Motion, Vec<FoundSpike>)> {
-    let spikes = find_spikes(&cleaned, options);
-    if spikes.is_empty() {
-        return Ok((cleaned, spikes));
-    }
-    Ok((rerun(&bridge_spikes(noisy, &spikes))?, spikes))
 }
 
 /// `motion` with the rotations of each spike's joint and subtree replaced,
@@ -398,6 +418,53 @@ mod tests {
         // Nothing outside the spike changed.
         for f in (0..60).chain(100..200) {
             assert_eq!(repaired.frame(f), noisy.frame(f));
+        }
+    }
+
+    #[test]
+    fn a_spike_under_ik_noise_is_found_in_global_rotations() {
+        use crate::noise::{add_random_noise_sigma, RandomNoise};
+        let clean = branching_motion(200);
+        let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(5);
+        let noisy = add_random_noise_sigma(&clean, 5.0, &RandomNoise::default(), &mut rng);
+        let mut donor = branching_motion(200);
+        let turn = Quat::from_rotation_x(70f32.to_radians());
+        for f in 0..200 {
+            for j in [5, 6] {
+                let q = donor.local_rotation(f, j) * turn;
+                donor.set_local_rotation(f, j, q);
+            }
+        }
+        let params = SpikeNoise::default();
+        let mut spike = [Spike {
+            joint: 5,
+            start: 80,
+            frames: 40,
+        }];
+        // `add_spikes` draws the joint: draw until it is the leg.
+        let (spiked, spikes) = (0..)
+            .map(|_| add_spikes(&noisy, &[&donor], &params, &mut spike, &mut rng).unwrap())
+            .find(|(_, s)| s[0].joint == 5)
+            .unwrap();
+        let found = find_spikes(&spiked, &DespikeOptions::default());
+        assert!(
+            found.iter().any(|f| f.joint == spikes[0].joint
+                && f.start.abs_diff(80) <= 1
+                && (f.start + f.frames).abs_diff(120) <= 1),
+            "{found:?}"
+        );
+        // Why global rotations: the noise swings the local rotations (each
+        // joint keeps its child near the keypoint), so the spike's jumps
+        // stand out less there.
+        let n = spiked.skeleton().joint_count();
+        let (global, local) = (
+            normalised_jumps(&spiked, 1, true),
+            normalised_jumps(&spiked, 1, false),
+        );
+        for t in [80, 120] {
+            for k in [5, 6] {
+                assert!(global[t * n + k] > local[t * n + k], "{t} {k}");
+            }
         }
     }
 

@@ -18,14 +18,12 @@
 //! model (rows `DETECTOR` and `DETECTOR + METHOD`): it looks for spikes in
 //! the noisy input, before anything smooths their ends.
 //!
-//! With [`EvalOptions::despike`], every method is also followed by spike
-//! finding ([`crate::despike`]; rows `METHOD + despike`, and `despike` alone
-//! on the noisy input), its threshold tuned per method the same way (on the
-//! spike condition). Spikes are looked for *after* the method: a denoiser
-//! removes the random noise that hides a spike's ends and leaves the spike.
-//! After a filter they are bridged in its output; after a model, as
-//! `mocap clean --despike` does, in the model's input before it runs again
-//! (the threshold is still tuned by bridging the output).
+//! With [`EvalOptions::despike`], every method is also preceded by spike
+//! finding ([`crate::despike`]; rows `despike + METHOD`, and `despike` alone),
+//! as `mocap clean --despike` does: spikes are looked for in the noisy input
+//! and bridged, then the method runs. Its settings (threshold, span, global
+//! or local rotations) are tuned per method the same way, on the spike
+//! condition, by running the whole pipeline.
 
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -40,7 +38,7 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::{
     list_bvh, load_takes, looped_window, paths_in_split, Split, SplitFractions, Take,
 };
-use crate::despike::{despike_and_rerun, remove_spikes, DespikeOptions};
+use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
 use crate::infer::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
@@ -262,48 +260,49 @@ fn tune(
     })
 }
 
-/// Spike-finding thresholds and spans tried when tuning.
-const DESPIKE_THRESHOLDS: [f32; 7] = [2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0];
-const DESPIKE_SPANS: [usize; 6] = [1, 2, 3, 4, 6, 8];
+/// Spike-finding thresholds and spans tried when tuning (with global and
+/// local rotations).
+const DESPIKE_THRESHOLDS: [f32; 6] = [2.0, 2.5, 3.0, 4.0, 5.0, 6.0];
+const DESPIKE_SPANS: [usize; 3] = [1, 2, 3];
 
 /// The spike-finding settings that give the lowest mean rotation error
-/// when run on `cleaner`'s output of the tuning takes (spike condition;
-/// `None`: on the noisy takes themselves).
+/// when the spikes are bridged in the tuning takes (spike condition) and
+/// `cleaner` runs on them (`None`: bridging alone).
 fn tune_despike(
     takes: &[Take],
     cleaner: Option<&Cleaner>,
     options: &EvalOptions,
 ) -> Result<(DespikeOptions, f64)> {
-    let cleaned: Vec<Motion> = (0..takes.len())
-        .map(|i| {
-            let noisy = make_noisy(takes, i, 1, options)?;
-            match cleaner {
-                Some(c) => c.run(&noisy),
-                None => Ok(noisy),
-            }
-        })
+    let noisy: Vec<Motion> = (0..takes.len())
+        .map(|i| make_noisy(takes, i, 1, options))
         .collect::<Result<_>>()?;
     let mut best: Option<(f64, DespikeOptions)> = None;
-    let grid = DESPIKE_SPANS
-        .iter()
-        .flat_map(|&span| DESPIKE_THRESHOLDS.map(|threshold| (span, threshold)));
-    for (span, threshold) in grid {
-        let despike = DespikeOptions {
-            threshold,
-            span,
-            ..DespikeOptions::default()
-        };
-        let sum: f64 = takes
-            .iter()
-            .zip(&cleaned)
-            .map(|(take, m)| rotation_error_deg(&take.motion, &remove_spikes(m, &despike).0))
-            .sum();
-        let mean = sum / takes.len().max(1) as f64;
-        if best.is_none_or(|(b, _)| mean < b) {
-            best = Some((mean, despike));
+    for span in DESPIKE_SPANS {
+        for threshold in DESPIKE_THRESHOLDS {
+            for global in [true, false] {
+                let despike = DespikeOptions {
+                    threshold,
+                    span,
+                    global,
+                    ..DespikeOptions::default()
+                };
+                let mut sum = 0.0;
+                for (take, m) in takes.iter().zip(&noisy) {
+                    let bridged = remove_spikes(m, &despike).0;
+                    let out = match cleaner {
+                        Some(c) => c.run(&bridged)?,
+                        None => bridged,
+                    };
+                    sum += rotation_error_deg(&take.motion, &out);
+                }
+                let mean = sum / takes.len().max(1) as f64;
+                if best.is_none_or(|(b, _)| mean < b) {
+                    best = Some((mean, despike));
+                }
+            }
         }
     }
-    let (error, despike) = best.expect("thresholds to try");
+    let (error, despike) = best.expect("settings to try");
     Ok((despike, error))
 }
 
@@ -371,24 +370,24 @@ fn run_methods(
         .map(|(_, c)| c.run(noisy))
         .collect::<Result<_>>()?;
     for (k, method) in methods.iter().enumerate() {
-        let cleaned = method.cleaner.map_or(noisy, |i| &outputs[i]);
-        match (&method.despike, method.cleaner.map(|i| &cleaners[i].1)) {
-            // As `mocap clean --despike` does after a model: the spikes
-            // found in its output bridged in its input, the model run again.
-            (Some(d), Some(model @ Cleaner::Model(_))) => take(
-                k,
-                &despike_and_rerun(noisy, cleaned.clone(), d, |bridged| model.run(bridged))?.0,
-            ),
-            (Some(d), _) => take(k, &remove_spikes(cleaned, d).0),
-            (None, _) => take(k, cleaned),
+        match (&method.despike, method.cleaner) {
+            // As `mocap clean --despike` does: spikes bridged first.
+            (Some(d), cleaner) => {
+                let bridged = remove_spikes(noisy, d).0;
+                match cleaner {
+                    Some(i) => take(k, &cleaners[i].1.run(&bridged)?),
+                    None => take(k, &bridged),
+                }
+            }
+            (None, cleaner) => take(k, cleaner.map_or(noisy, |i| &outputs[i])),
         }
     }
     Ok(())
 }
 
 /// The methods: `cleaners` as they are, then (when spike finding is asked)
-/// spike finding alone and every cleaner followed by it, with thresholds
-/// tuned per method on `tune_takes` (remembered by label in `tuned`).
+/// spike finding alone and before every cleaner, with settings tuned per
+/// method on `tune_takes` (remembered by label in `tuned`).
 fn methods(
     cleaners: &[&(String, Cleaner)],
     options: &EvalOptions,
@@ -411,7 +410,7 @@ fn methods(
         cleaners
             .iter()
             .enumerate()
-            .map(|(i, (label, _))| (format!("{label} + despike"), Some(i))),
+            .map(|(i, (label, _))| (format!("despike + {label}"), Some(i))),
     );
     for (label, cleaner) in with_despike {
         let despike = match tuned.iter().find(|(l, _, _)| *l == label) {
@@ -616,12 +615,15 @@ impl EvalReport {
         let mut s = format!("{} takes, {} frames.\n\n", self.takes, self.frames);
         if !self.tuned_despike.is_empty() {
             s += "Spike finding tuned on the validation takes (spike condition):\n\n\
-                  | method | threshold | span (frames) | longest spike (frames) | rotation error there (deg) |\n\
-                  | --- | ---: | ---: | ---: | ---: |\n";
+                  | method | threshold | span (frames) | rotations | longest spike (frames) | rotation error there (deg) |\n\
+                  | --- | ---: | ---: | --- | ---: | ---: |\n";
             for (label, d, error) in &self.tuned_despike {
                 s += &format!(
-                    "| {label} | {} | {} | {} | {error:.3} |\n",
-                    d.threshold, d.span, d.max_frames
+                    "| {label} | {} | {} | {} | {} | {error:.3} |\n",
+                    d.threshold,
+                    d.span,
+                    if d.global { "global" } else { "local" },
+                    d.max_frames
                 );
             }
             s += "\n";

@@ -24,7 +24,7 @@ use mocap_nn::checkpoint::{header_from_bytes, load_weights_from_bytes};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
-use crate::despike::{despike_and_rerun, remove_spikes, DespikeOptions, FoundSpike};
+use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::FeatureLayout;
 use crate::filters::{filter_motion, Filter};
 use crate::model::{Denoiser, Head};
@@ -181,6 +181,17 @@ impl CleanModel {
         motion: &Motion,
         hop: Option<usize>,
     ) -> Result<(Motion, Option<f64>)> {
+        self.clean_at_level(motion, hop, None)
+    }
+
+    /// [`CleanModel::clean_reporting`] with the noise level (degrees) of its
+    /// Wiener filter given instead of estimated, when `level_deg` is set.
+    pub fn clean_at_level(
+        &self,
+        motion: &Motion,
+        hop: Option<usize>,
+        level_deg: Option<f64>,
+    ) -> Result<(Motion, Option<f64>)> {
         if self.description.network.head != Head::Correction {
             return Err(CleanError::Invalid(format!(
                 "{} is a spike detector (`mocap clean train --spike-detector`), not a denoiser: \
@@ -209,7 +220,7 @@ impl CleanModel {
         let filtered_take = match &base {
             Some(base) if self.description.base_context > 0 => {
                 let mut filtered = features.clone();
-                noise_deg = base.apply(&mut filtered, c);
+                noise_deg = base.apply(&mut filtered, c, level_deg);
                 Some(filtered)
             }
             _ => None,
@@ -405,8 +416,8 @@ pub struct CleanOptions {
     pub device: DeviceChoice,
     /// Frames between window starts (default: a quarter window).
     pub hop: Option<usize>,
-    /// Look for spikes after cleaning and bridge them ([`crate::despike`]):
-    /// in a model's input before it runs again, in a filter's output.
+    /// Look for spikes in the input and bridge them before cleaning
+    /// ([`crate::despike`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
     /// Find spikes with the learned detector *before* cleaning and bridge
@@ -453,22 +464,27 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         other => other,
     };
     let start = Instant::now();
-    // The take the method cleans: the input, or its copy with the detected
-    // spikes bridged.
-    let (motion, detected_spikes) = match &options.find_spikes {
-        Some(find) => {
-            let detector = SpikeDetector::load(&find.model, options.device)?;
-            let (bridged, found) = detector
-                .remove_spikes(&original, &find.options)
-                .map_err(in_file)?;
+    // The take the method cleans: the input, or its copy with the spikes
+    // found (by rules, then by the learned detector) bridged.
+    let (motion, spikes) = match &options.despike {
+        Some(despike) => {
+            let (bridged, found) = remove_spikes(&original, despike);
             (Cow::Owned(bridged), found)
         }
         None => (Cow::Borrowed(&original), Vec::new()),
     };
+    let (motion, detected_spikes) = match &options.find_spikes {
+        Some(find) => {
+            let detector = SpikeDetector::load(&find.model, options.device)?;
+            let (bridged, found) = detector
+                .remove_spikes(&motion, &find.options)
+                .map_err(in_file)?;
+            (Cow::Owned(bridged), found)
+        }
+        None => (motion, Vec::new()),
+    };
     let detect_seconds = start.elapsed().as_secs_f64();
-    // The model, kept for a second run when spikes are found after it.
-    let mut model_file = None;
-    let (cleaned, method, mut seconds) = match &options.method {
+    let (cleaned, method, seconds) = match &options.method {
         Method::SpikesOnly => {
             if options.despike.is_none() && options.find_spikes.is_none() {
                 return Err(CleanError::Invalid(
@@ -498,27 +514,12 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             };
             let start = Instant::now();
             let (out, label) = model.clean(&motion, options.hop).map_err(in_file)?;
-            model_file = Some(model);
             (
                 out,
                 format!("{label} {}", source.display()),
                 start.elapsed().as_secs_f64(),
             )
         }
-    };
-    let (cleaned, spikes) = match (&options.despike, &model_file) {
-        // After a model, its spikes are bridged in its input and it runs
-        // again (`despike_and_rerun`).
-        (Some(despike), Some(model)) => {
-            let start = Instant::now();
-            let out = despike_and_rerun(&motion, cleaned, despike, |bridged| {
-                Ok(model.clean(bridged, options.hop).map_err(in_file)?.0)
-            })?;
-            seconds += start.elapsed().as_secs_f64();
-            out
-        }
-        (Some(despike), None) => remove_spikes(&cleaned, despike),
-        (None, _) => (cleaned, Vec::new()),
     };
     write_bvh(&options.output, &cleaned)?;
     let frames = motion.frame_count();
@@ -660,7 +661,7 @@ mod tests {
     }
 
     #[test]
-    fn spikes_found_after_a_model_are_bridged_in_its_input_before_it_runs_again() {
+    fn spikes_are_found_in_the_input_and_bridged_before_the_model_runs() {
         use crate::noise::RandomNoise;
         use crate::test_support::synthetic_motion_phase;
         use crate::wiener::WienerFilter;
@@ -682,10 +683,7 @@ mod tests {
         }
         let input = dir.path().join("spiked.bvh");
         mocap_core::io::bvh::write_bvh(&input, &spiked).unwrap();
-        let despike = DespikeOptions {
-            span: 1,
-            ..DespikeOptions::default()
-        };
+        let despike = DespikeOptions::default();
         let output = dir.path().join("out.bvh");
         let report = clean_file(&CleanOptions {
             input: input.clone(),
@@ -701,8 +699,8 @@ mod tests {
         let spike = report.spikes[0];
         assert_eq!(spike.joint, 2);
         assert!(spike.start.abs_diff(100) <= 2 && (spike.start + spike.frames).abs_diff(140) <= 2);
-        // What was written: the filter run again on the input with the spike
-        // bridged, not the first output with the spike bridged.
+        // What was written: the filter run on the input with the spike
+        // bridged, not its output with the spike bridged.
         let spiked = read_bvh(&input).unwrap();
         let written = read_bvh(&output).unwrap();
         let (again, _) = wiener

@@ -134,14 +134,20 @@ impl<'a> Base<'a> {
     }
 
     /// Filters `features` (frames x `channels`) in place; a Wiener filter
-    /// also says the noise level it estimated (degrees).
-    pub(crate) fn apply(&self, features: &mut [f32], channels: usize) -> Option<f64> {
+    /// also says the noise level it used (degrees): `level_deg` when given,
+    /// else the one it estimated.
+    pub(crate) fn apply(
+        &self,
+        features: &mut [f32],
+        channels: usize,
+        level_deg: Option<f64>,
+    ) -> Option<f64> {
         match self {
             Base::Classical(filter, fps) => {
                 filter_features(features, channels, filter, *fps);
                 None
             }
-            Base::Wiener(wiener) => Some(wiener.filter_features(features, None).sigma_deg),
+            Base::Wiener(wiener) => Some(wiener.filter_features(features, level_deg).sigma_deg),
         }
     }
 }
@@ -488,7 +494,7 @@ impl<'a> WindowSampler<'a> {
                     let mut stretch_level = None;
                     let around = (self.context > 0).then(|| {
                         let mut filtered = xs.clone();
-                        stretch_level = base.apply(&mut filtered, c);
+                        stretch_level = base.apply(&mut filtered, c, None);
                         crop(&filtered)
                     });
                     let (base, window_level) =
@@ -542,7 +548,7 @@ pub(crate) fn window_base(
         }
         None => {
             let mut filtered = window.to_vec();
-            let level = base.apply(&mut filtered, channels);
+            let level = base.apply(&mut filtered, channels, None);
             (filtered, level)
         }
     }
@@ -1294,6 +1300,16 @@ mod tests {
         let off = crate::eval::rotation_error_deg(&filtered, &zeroed);
         assert!(off < 1e-3, "{off} degrees from the Wiener filter");
         assert!(crate::eval::rotation_error_deg(&filtered, &noisy) > 0.1);
+        // A noise level given instead of estimated reaches the filter.
+        let (at_level, level) = model.clean_at_level(&noisy, None, Some(1.0)).unwrap();
+        assert_eq!(level, Some(1.0));
+        let (filtered_at_level, _) = model_base(&model).clean(&noisy, Some(1.0)).unwrap();
+        let off = crate::eval::rotation_error_deg(&filtered_at_level, &at_level);
+        assert!(
+            off < 1e-3,
+            "{off} degrees from the Wiener filter at 1 degree"
+        );
+        assert!(crate::eval::rotation_error_deg(&filtered_at_level, &filtered) > 0.01);
         // Not both bases, and not on features a Wiener filter cannot read.
         std::fs::rename(&kept, &wiener_path).unwrap();
         for (wrong, why) in [

@@ -12,8 +12,10 @@ pub struct StudyArgs {
     /// At most this many validation takes (default 40).
     pub takes: usize,
     /// The noise levels, degrees (default 0,1,2,4,6,8,10).
+    #[allow(dead_code)] // not every study has levels
     pub sigmas: Vec<f32>,
     /// Arguments after SIGMAS, for the study's own.
+    #[allow(dead_code)] // not every study has more
     pub rest: Vec<String>,
 }
 

@@ -61,20 +61,19 @@ struct TakeArgs {
     /// Frames between window starts (default: a quarter window).
     #[arg(long)]
     hop: Option<usize>,
-    /// After cleaning, find spikes (a joint and its subtree jumping away and back) and bridge them:
-    /// after a model in its input, which it then cleans again; see bench/results/clean.md for what
-    /// it gains and costs.
+    /// Before cleaning, find spikes (a joint and its subtree jumping away and back) in the take and
+    /// bridge them; see bench/results/clean.md for what it gains and costs.
     #[arg(long)]
     despike: bool,
     /// Only find and bridge spikes (with --despike), no denoising: for takes with spikes and little
     /// random noise, whose spikes the shipped model takes for noise (see bench/results/clean.md).
     #[arg(long, requires = "despike", conflicts_with_all = ["model", "filter"])]
     despike_only: bool,
-    /// Spike finding: a boundary is a subtree jump this many times the joints' median jump.
+    /// Spike finding: a boundary is a subtree jump this many times the joints' upper-quartile jump
+    /// (default 3).
     #[arg(long, requires = "despike")]
     despike_threshold: Option<f32>,
-    /// Spike finding: frames averaged on each side of a boundary (default 3 after cleaning, 2 with
-    /// --despike-only).
+    /// Spike finding: frames averaged on each side of a boundary (default 1).
     #[arg(long, requires = "despike")]
     despike_span: Option<usize>,
     /// Before cleaning, find spikes (a joint and its subtree taking another motion's rotations) with
@@ -287,11 +286,7 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         (None, None) => Method::DefaultModel,
     };
     let despike = a.despike.then(|| {
-        let mut d = if a.despike_only {
-            DespikeOptions::default()
-        } else {
-            DespikeOptions::after_denoising()
-        };
+        let mut d = DespikeOptions::default();
         set(&mut d.threshold, a.despike_threshold);
         set(&mut d.span, a.despike_span);
         d

@@ -1,0 +1,352 @@
+//! Study: which spikes does rule-based spike finding miss, and where should
+//! it look?
+//!
+//! On validation takes with random noise (sigma drawn in 0-10 degrees) and
+//! 1-3 spikes, seeded as `spike_oracle` seeds its last row, spikes are looked
+//! for either in the shipped model's output (as sessions 4-8 did) or in the
+//! noisy input (as `mocap clean --despike` does now), on local or global
+//! rotations ([`DespikeOptions::global`]), with a grid of spans and
+//! thresholds; they are bridged in the input and the model runs on it. Printed: the mean
+//! rotation error of each setting, two oracles (the true spikes bridged; the
+//! model at the noise level estimated without spikes), the best fixed filter
+//! of the evaluation's spike condition (Butterworth, 2 Hz), and, for the old and
+//! the new default, every true spike sorted into found / found on a joint
+//! above or below / missed (by why), weighted by the error it adds to the
+//! input. `SPIKE_DETAILS=1` lists the missed spikes with their jumps.
+//!
+//! cargo run --profile test -p mocap-clean --example spike_finding -- DATA [TAKES]
+
+mod support;
+
+use std::time::Instant;
+
+use mocap_clean::dataset::looped_window;
+use mocap_clean::despike::{
+    bridge_spikes, find_spikes, normalised_jumps, DespikeOptions, FoundSpike,
+};
+use mocap_clean::eval::rotation_error_deg;
+use mocap_clean::filters::{filter_motion, Filter};
+use mocap_clean::infer::CleanModel;
+use mocap_clean::noise::{add_random_noise, add_spike_noise, RandomNoise, SpikeNoise};
+use mocap_core::rotation::angle_between;
+use mocap_core::Motion;
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+
+struct TakeResult {
+    frames: usize,
+    /// Error times frames, per setting, then the two oracles.
+    errors: Vec<f64>,
+    /// Per sorted setting: the true spikes' (category, error mass in degrees
+    /// x joint-frames), the found spikes matching none, the missed spikes.
+    sorted: Vec<Sorting>,
+    /// The noise level estimated without and with the spikes.
+    levels: (f64, f64),
+}
+
+struct Sorting {
+    spikes: Vec<(&'static str, f64)>,
+    false_found: usize,
+    details: Vec<String>,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args = support::parse()?;
+    let model = CleanModel::load_default(Default::default())?;
+    let takes = args.validation_takes()?;
+    // (label, where spikes are looked for: 0 the model's output, 1 the
+    // noisy input; options)
+    let mut settings: Vec<(String, usize, Option<DespikeOptions>)> =
+        vec![("no spike finding".to_string(), 0, None)];
+    for (signal, place) in [(0, "model output"), (1, "input")] {
+        for global in [false, true] {
+            for span in [1, 2, 3] {
+                for threshold in [2.0f32, 2.5, 3.0, 4.0, 5.0] {
+                    settings.push((
+                        format!(
+                            "{place}, {} rotations, span {span}, threshold {threshold}",
+                            if global { "global" } else { "local" },
+                        ),
+                        signal,
+                        Some(DespikeOptions {
+                            span,
+                            threshold,
+                            global,
+                            ..DespikeOptions::default()
+                        }),
+                    ));
+                }
+            }
+        }
+    }
+    // The spikes of these two are sorted: sessions 4-8's setting and the
+    // default.
+    let sorted = [
+        (
+            "model output, local rotations, span 3, threshold 3 (sessions 4-8)",
+            0,
+            DespikeOptions {
+                span: 3,
+                threshold: 3.0,
+                global: false,
+                ..DespikeOptions::default()
+            },
+        ),
+        (
+            "input, default settings (--despike)",
+            1,
+            DespikeOptions::default(),
+        ),
+    ];
+    let started = Instant::now();
+    let results: Vec<TakeResult> = (0..takes.len())
+        .into_par_iter()
+        .map(|i| {
+            let key = u32::MAX as u64;
+            let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+            let clean = &takes[i].motion;
+            let n = clean.frame_count();
+            let noisy = add_random_noise(clean, &RandomNoise::default(), &mut rng).0;
+            let donors: Vec<Motion> = (0..3)
+                .map(|_| {
+                    let mut d = rng.random_range(0..takes.len());
+                    if d == i {
+                        d = (d + 1) % takes.len();
+                    }
+                    let donor = &takes[d].motion;
+                    looped_window(donor, rng.random_range(0..donor.frame_count()), n)
+                })
+                .collect();
+            let donor_refs: Vec<&Motion> = donors.iter().collect();
+            let (spiked, spikes) =
+                add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
+                    .expect("spikes");
+            let (cleaned, spiked_level) = model.clean_reporting(&spiked, None).expect("clean");
+            let (_, noisy_level) = model.clean_reporting(&noisy, None).expect("clean");
+            let looked_at = |signal: usize| [&cleaned, &spiked][signal];
+            let mut errors: Vec<f64> = settings
+                .iter()
+                .map(|(_, signal, options)| {
+                    let out = match options {
+                        None => cleaned.clone(),
+                        Some(o) => {
+                            let found = find_spikes(looked_at(*signal), o);
+                            model
+                                .clean(&bridge_spikes(&spiked, &found), None)
+                                .expect("clean")
+                        }
+                    };
+                    rotation_error_deg(clean, &out) * n as f64
+                })
+                .collect();
+            let truth: Vec<FoundSpike> = spikes
+                .iter()
+                .map(|s| FoundSpike {
+                    joint: s.joint,
+                    start: s.start,
+                    frames: s.frames,
+                })
+                .collect();
+            let oracle = model
+                .clean(&bridge_spikes(&spiked, &truth), None)
+                .expect("clean");
+            errors.push(rotation_error_deg(clean, &oracle) * n as f64);
+            let at_noisy_level = model
+                .clean_at_level(&spiked, None, noisy_level)
+                .expect("clean")
+                .0;
+            errors.push(rotation_error_deg(clean, &at_noisy_level) * n as f64);
+            // The reference of the issue's target: the best fixed filter on
+            // the evaluation's spike condition.
+            let butterworth = filter_motion(
+                &spiked,
+                &Filter::Butterworth {
+                    order: 2,
+                    cutoff_hz: 2.0,
+                },
+            )
+            .expect("filter");
+            errors.push(rotation_error_deg(clean, &butterworth) * n as f64);
+            let sorted = sorted
+                .iter()
+                .map(|(_, signal, options)| {
+                    sort_spikes(
+                        i,
+                        clean,
+                        &noisy,
+                        looked_at(*signal),
+                        &spiked,
+                        &truth,
+                        options,
+                    )
+                })
+                .collect();
+            TakeResult {
+                frames: n,
+                errors,
+                sorted,
+                levels: (noisy_level.unwrap_or(0.0), spiked_level.unwrap_or(0.0)),
+            }
+        })
+        .collect();
+    let frames: usize = results.iter().map(|r| r.frames).sum();
+    println!(
+        "{} validation takes, {frames} frames, sigma drawn in 0-10, 1-3 spikes; spikes found (where the setting \
+         says) bridged in the input, then the shipped model. Mean rotation error (degrees).\n",
+        takes.len()
+    );
+    println!("| setting | error |\n| --- | ---: |");
+    let mean =
+        |column: usize| results.iter().map(|r| r.errors[column]).sum::<f64>() / frames as f64;
+    for (s, (label, _, _)) in settings.iter().enumerate() {
+        println!("| {label} | {:.3} |", mean(s));
+    }
+    println!(
+        "| oracle: true spikes bridged | {:.3} |",
+        mean(settings.len())
+    );
+    println!(
+        "| oracle: no spike finding, the model at the level estimated without spikes | {:.3} |",
+        mean(settings.len() + 1)
+    );
+    println!(
+        "| reference: butterworth 2 Hz (2nd order), no spike finding | {:.3} |",
+        mean(settings.len() + 2)
+    );
+    let lift: Vec<f64> = results.iter().map(|r| r.levels.1 - r.levels.0).collect();
+    println!(
+        "\nNoise level estimated with spikes minus without: mean {:.2} deg, largest {:.2} deg",
+        lift.iter().sum::<f64>() / lift.len() as f64,
+        lift.iter().cloned().fold(f64::MIN, f64::max)
+    );
+    for (k, (label, _, options)) in sorted.iter().enumerate() {
+        println!(
+            "\nTrue spikes, {label} ({options:?}); error mass = degrees summed over the spike's joints and \
+             frames (noisy against spiked).\n"
+        );
+        println!("| category | spikes | share of error mass |\n| --- | ---: | ---: |");
+        let all: Vec<(&str, f64)> = results
+            .iter()
+            .flat_map(|r| r.sorted[k].spikes.clone())
+            .collect();
+        let total: f64 = all.iter().map(|s| s.1).sum();
+        let mut categories: Vec<&str> = all.iter().map(|s| s.0).collect();
+        categories.sort();
+        categories.dedup();
+        for c in categories {
+            let count = all.iter().filter(|s| s.0 == c).count();
+            let mass: f64 = all.iter().filter(|s| s.0 == c).map(|s| s.1).sum();
+            println!("| {c} | {count} | {:.1}% |", 100.0 * mass / total);
+        }
+        let false_found: usize = results.iter().map(|r| r.sorted[k].false_found).sum();
+        println!("\nFound spikes matching no true spike: {false_found}");
+        if std::env::var_os("SPIKE_DETAILS").is_some() {
+            println!("\nMissed (other), normalised jumps of the subtree's joints:\n");
+            for r in &results {
+                for d in &r.sorted[k].details {
+                    println!("- {d}");
+                }
+            }
+        }
+    }
+    println!("\n{:.0} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// Sorts the true spikes of take `take` by what spike finding with
+/// `options` on `looked_at` made of them.
+fn sort_spikes(
+    take: usize,
+    clean: &Motion,
+    noisy: &Motion,
+    looked_at: &Motion,
+    spiked: &Motion,
+    truth: &[FoundSpike],
+    options: &DespikeOptions,
+) -> Sorting {
+    let skeleton = clean.skeleton();
+    let n = clean.frame_count();
+    let found = find_spikes(looked_at, options);
+    let related =
+        |a: usize, b: usize| skeleton.subtree(a).contains(&b) || skeleton.subtree(b).contains(&a);
+    let overlap = |a: &FoundSpike, s: &FoundSpike| {
+        let lo = a.start.max(s.start);
+        let hi = (a.start + a.frames).min(s.start + s.frames);
+        let union = (a.start + a.frames).max(s.start + s.frames) - a.start.min(s.start);
+        hi.saturating_sub(lo) as f64 / union.max(1) as f64
+    };
+    let mut matched = vec![false; found.len()];
+    let jump = normalised_jumps(looked_at, options.span, options.global);
+    let joint_count = skeleton.joint_count();
+    let mut details = Vec::new();
+    let spikes = truth
+        .iter()
+        .map(|s| {
+            let joints: Vec<usize> = skeleton
+                .subtree(s.joint)
+                .into_iter()
+                .filter(|&k| skeleton.joint(k).has_rotation_channels())
+                .collect();
+            let mut mass = 0.0f64;
+            let mut biggest = 0.0f32;
+            for f in s.start..s.start + s.frames {
+                for &k in &joints {
+                    let e = angle_between(noisy.local_rotation(f, k), spiked.local_rotation(f, k))
+                        .to_degrees();
+                    mass += e as f64;
+                    biggest = biggest.max(e);
+                }
+            }
+            let mut category = "";
+            for (m, f) in found.iter().enumerate() {
+                if overlap(f, s) >= 0.5 {
+                    if f.joint == s.joint {
+                        matched[m] = true;
+                        category = "found";
+                        break;
+                    } else if related(f.joint, s.joint) {
+                        matched[m] = true;
+                        category = "found on a joint above or below";
+                    }
+                }
+            }
+            if category.is_empty() {
+                category = if joints.len() < 2 {
+                    "missed: leaf joint"
+                } else if s.start + s.frames >= n {
+                    "missed: runs into the end"
+                } else if biggest < 10.0 {
+                    "missed: under 10 degrees"
+                } else if s.frames <= 2 {
+                    "missed: 1-2 frames"
+                } else {
+                    "missed: other"
+                };
+            }
+            if category == "missed: other" {
+                let at = |t: usize| {
+                    joints
+                        .iter()
+                        .map(|&k| format!("{:.1}", jump[t.min(n - 1) * joint_count + k]))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                details.push(format!(
+                    "take {take} ({n} frames) {}@{}+{} max {biggest:.0} deg; jumps at start [{}] at end [{}]",
+                    skeleton.joint(s.joint).name,
+                    s.start,
+                    s.frames,
+                    at(s.start),
+                    at(s.start + s.frames)
+                ));
+            }
+            (category, mass)
+        })
+        .collect();
+    Sorting {
+        spikes,
+        false_found: matched.iter().filter(|&&m| !m).count(),
+        details,
+    }
+}
