@@ -449,11 +449,37 @@ pub struct CleanReport {
     pub mean_change_deg: f64,
     /// The spikes found and bridged (with `despike`).
     #[serde(default)]
-    pub spikes: Vec<FoundSpike>,
+    pub spikes: Vec<BridgedSpike>,
     /// The spikes the learned detector found and bridged before cleaning
     /// (with `find_spikes`): the top joint of each marked subtree.
     #[serde(default)]
-    pub detected_spikes: Vec<FoundSpike>,
+    pub detected_spikes: Vec<BridgedSpike>,
+}
+
+/// A spike that was bridged, as reported: its joint by name (the joints
+/// below it were bridged too) and its frames `start..start + frames`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BridgedSpike {
+    pub joint: String,
+    pub start: usize,
+    pub frames: usize,
+    /// `start` in seconds from the take's first frame.
+    pub start_seconds: f64,
+    /// `frames` in seconds.
+    pub seconds: f64,
+}
+
+impl BridgedSpike {
+    fn new(motion: &Motion, spike: &FoundSpike) -> BridgedSpike {
+        let frame_time = motion.frame_time();
+        BridgedSpike {
+            joint: motion.skeleton().joint(spike.joint).name.clone(),
+            start: spike.start,
+            frames: spike.frames,
+            start_seconds: spike.start as f64 * frame_time,
+            seconds: spike.frames as f64 * frame_time,
+        }
+    }
 }
 
 /// Reads a take, cleans it and writes it (atomically).
@@ -532,8 +558,14 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         seconds,
         frames_per_second: frames as f64 / seconds.max(1e-9),
         mean_change_deg: crate::eval::rotation_error_deg(&original, &cleaned),
-        spikes,
-        detected_spikes,
+        spikes: spikes
+            .iter()
+            .map(|s| BridgedSpike::new(&original, s))
+            .collect(),
+        detected_spikes: detected_spikes
+            .iter()
+            .map(|s| BridgedSpike::new(&original, s))
+            .collect(),
     })
 }
 
@@ -696,19 +728,26 @@ mod tests {
         })
         .unwrap();
         assert_eq!(report.spikes.len(), 1, "{:?}", report.spikes);
-        let spike = report.spikes[0];
-        assert_eq!(spike.joint, 2);
+        let spike = &report.spikes[0];
+        // Reported by name and in seconds too.
+        let spiked = read_bvh(&input).unwrap();
+        assert_eq!(spike.joint, spiked.skeleton().joint(2).name);
         assert!(spike.start.abs_diff(100) <= 2 && (spike.start + spike.frames).abs_diff(140) <= 2);
+        let frame_time = spiked.frame_time();
+        assert!((spike.start_seconds - spike.start as f64 * frame_time).abs() < 1e-9);
+        assert!((spike.seconds - spike.frames as f64 * frame_time).abs() < 1e-9);
         // What was written: the filter run on the input with the spike
         // bridged, not its output with the spike bridged.
-        let spiked = read_bvh(&input).unwrap();
+        let found = [FoundSpike {
+            joint: 2,
+            start: spike.start,
+            frames: spike.frames,
+        }];
         let written = read_bvh(&output).unwrap();
-        let (again, _) = wiener
-            .clean(&bridge_spikes(&spiked, &report.spikes), None)
-            .unwrap();
+        let (again, _) = wiener.clean(&bridge_spikes(&spiked, &found), None).unwrap();
         assert!(crate::eval::rotation_error_deg(&again, &written) < 1e-3);
         let (first, _) = wiener.clean(&spiked, None).unwrap();
-        let bridged_after = bridge_spikes(&first, &report.spikes);
+        let bridged_after = bridge_spikes(&first, &found);
         assert!(crate::eval::rotation_error_deg(&bridged_after, &written) > 0.01);
     }
 

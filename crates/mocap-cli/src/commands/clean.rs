@@ -12,7 +12,7 @@ use mocap_clean::despike::DespikeOptions;
 use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
 use mocap_clean::features::{Representation, RotationFrame};
 use mocap_clean::filters::Filter;
-use mocap_clean::infer::{clean_file, CleanOptions, FindSpikes, Method};
+use mocap_clean::infer::{clean_file, BridgedSpike, CleanOptions, FindSpikes, Method};
 use mocap_clean::model::DenoiserConfig;
 use mocap_clean::spikes::SpikeOptions;
 use mocap_clean::training::{train, TrainOptions};
@@ -317,14 +317,28 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.mean_change_deg,
             report.frames_per_second
         );
+        let list = |spikes: &[BridgedSpike]| {
+            for s in spikes {
+                eprintln!(
+                    "  {} and below: frames {}-{} ({:.2}-{:.2} s)",
+                    s.joint,
+                    s.start,
+                    s.start + s.frames - 1,
+                    s.start_seconds,
+                    s.start_seconds + s.seconds
+                );
+            }
+        };
         if find_spikes_asked {
             eprintln!(
                 "spike detector: bridged {} spikes before cleaning",
                 report.detected_spikes.len()
             );
+            list(&report.detected_spikes);
         }
         if a.despike {
-            eprintln!("bridged {} spikes", report.spikes.len());
+            eprintln!("bridged {} spikes before cleaning", report.spikes.len());
+            list(&report.spikes);
         }
     }
     Ok(())
