@@ -23,16 +23,12 @@
 
 mod support;
 
-use mocap_clean::dataset::looped_window;
 use mocap_clean::despike::normalised_jumps;
 use mocap_clean::features::{FeatureLayout, Representation};
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::{add_random_noise, add_spike_noise, RandomNoise, SpikeNoise};
 use mocap_core::rotation::{angle_between, expmap_to_quat, quat_to_expmap};
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, Motion};
-use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 /// The value at the boundary (position 0) of the least-squares line through
@@ -107,25 +103,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let per_take: Vec<Vec<(Vec<f32>, Vec<f32>)>> = (0..takes.len())
         .into_par_iter()
         .map(|i| {
-            let key = u32::MAX as u64;
-            let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+            let support::SpikedTake {
+                noisy,
+                spiked,
+                spikes,
+            } = support::spiked_take(&takes, i, None);
             let clean = &takes[i].motion;
             let n_frames = clean.frame_count();
-            let noisy = add_random_noise(clean, &RandomNoise::default(), &mut rng).0;
-            let donors: Vec<Motion> = (0..3)
-                .map(|_| {
-                    let mut d = rng.random_range(0..takes.len());
-                    if d == i {
-                        d = (d + 1) % takes.len();
-                    }
-                    let donor = &takes[d].motion;
-                    looped_window(donor, rng.random_range(0..donor.frame_count()), n_frames)
-                })
-                .collect();
-            let donor_refs: Vec<&Motion> = donors.iter().collect();
-            let (spiked, spikes) =
-                add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
-                    .expect("spikes");
             let cleaned = model.clean(&spiked, None).expect("clean");
             let layout = FeatureLayout::new(clean.skeleton(), Representation::Rot6d).expect("rig");
             let mut features = layout.encode(&spiked);
@@ -189,21 +173,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             out.into_iter()
                 .map(|(stat, margin)| {
-                    let (mut pos, mut neg) = (Vec::new(), Vec::new());
-                    if n_frames < 2 * margin + 1 {
-                        return (pos, neg);
-                    }
-                    for t in margin..=n_frames - margin {
-                        for &k in &joints {
-                            let v = stat[t * n + k];
-                            if positive[t * n + k] {
-                                pos.push(v);
-                            } else if !near[t * n + k] {
-                                neg.push(v);
-                            }
-                        }
-                    }
-                    (pos, neg)
+                    split_scores(&stat, n, n_frames, margin, &joints, &positive, &near)
                 })
                 .collect()
         })
@@ -213,25 +183,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          by >= 20 degrees) at a false-positive rate per joint and frame.\n",
         takes.len()
     );
-    println!(
-        "| statistic | positives | recall at 1% | recall at 0.1% |\n| --- | ---: | ---: | ---: |"
-    );
-    for (s, name) in names.iter().enumerate() {
-        let mut pos: Vec<f32> = per_take.iter().flat_map(|t| t[s].0.clone()).collect();
-        let mut neg: Vec<f32> = per_take.iter().flat_map(|t| t[s].1.clone()).collect();
-        neg.sort_by(f32::total_cmp);
-        pos.sort_by(f32::total_cmp);
-        let at = |q: f64| {
-            let cut = neg[((neg.len() as f64) * q) as usize];
-            pos.iter().filter(|&&v| v > cut).count() as f64 / pos.len() as f64
-        };
-        println!(
-            "| {name} | {} | {:.3} | {:.3} |",
-            pos.len(),
-            at(0.99),
-            at(0.999)
-        );
-    }
+    print_recall(&names, &per_take);
     Ok(())
 }
 
@@ -300,25 +252,13 @@ fn subtree_level(takes: &[mocap_clean::dataset::Take], model: &CleanModel) {
     let per_take: Vec<Vec<(Vec<f32>, Vec<f32>)>> = (0..takes.len())
         .into_par_iter()
         .map(|i| {
-            let key = u32::MAX as u64;
-            let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+            let support::SpikedTake {
+                noisy,
+                spiked,
+                spikes,
+            } = support::spiked_take(takes, i, None);
             let clean = &takes[i].motion;
             let n_frames = clean.frame_count();
-            let noisy = add_random_noise(clean, &RandomNoise::default(), &mut rng).0;
-            let donors: Vec<Motion> = (0..3)
-                .map(|_| {
-                    let mut d = rng.random_range(0..takes.len());
-                    if d == i {
-                        d = (d + 1) % takes.len();
-                    }
-                    let donor = &takes[d].motion;
-                    looped_window(donor, rng.random_range(0..donor.frame_count()), n_frames)
-                })
-                .collect();
-            let donor_refs: Vec<&Motion> = donors.iter().collect();
-            let (spiked, spikes) =
-                add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
-                    .expect("spikes");
             let cleaned = model.clean(&spiked, None).expect("clean");
             let skeleton = clean.skeleton();
             let n = skeleton.joint_count();
@@ -432,35 +372,53 @@ fn subtree_level(takes: &[mocap_clean::dataset::Take], model: &CleanModel) {
             stats.extend(raws);
             stats
                 .into_iter()
-                .map(|stat| {
-                    let (mut pos, mut neg) = (Vec::new(), Vec::new());
-                    if n_frames < 2 * margin + 1 {
-                        return (pos, neg);
-                    }
-                    for t in margin..=n_frames - margin {
-                        for &j in &candidates {
-                            let v = stat[t * n + j];
-                            if positive[t * n + j] {
-                                pos.push(v);
-                            } else if !near[t * n + j] {
-                                neg.push(v);
-                            }
-                        }
-                    }
-                    (pos, neg)
-                })
+                .map(|stat| split_scores(&stat, n, n_frames, margin, &candidates, &positive, &near))
                 .collect()
         })
         .collect();
     println!("Subtree level: recall of spike boundaries at a false-positive rate per candidate joint and frame.\n");
+    print_recall(&names, &per_take);
+    println!();
+}
+
+/// The scores of `stat` (frames x `n` joints) at `joints`, frames `margin`
+/// from either end: (at positive boundaries, away from every boundary).
+fn split_scores(
+    stat: &[f32],
+    n: usize,
+    n_frames: usize,
+    margin: usize,
+    joints: &[usize],
+    positive: &[bool],
+    near: &[bool],
+) -> (Vec<f32>, Vec<f32>) {
+    let (mut pos, mut neg) = (Vec::new(), Vec::new());
+    if n_frames < 2 * margin + 1 {
+        return (pos, neg);
+    }
+    for t in margin..=n_frames - margin {
+        for &k in joints {
+            let v = stat[t * n + k];
+            if positive[t * n + k] {
+                pos.push(v);
+            } else if !near[t * n + k] {
+                neg.push(v);
+            }
+        }
+    }
+    (pos, neg)
+}
+
+/// The recall table: per statistic, the share of positives above the
+/// negatives' 99th and 99.9th percentiles.
+fn print_recall<S: std::fmt::Display>(names: &[S], per_take: &[Vec<(Vec<f32>, Vec<f32>)>]) {
     println!(
         "| statistic | positives | recall at 1% | recall at 0.1% |\n| --- | ---: | ---: | ---: |"
     );
     for (s, name) in names.iter().enumerate() {
-        let mut pos: Vec<f32> = per_take.iter().flat_map(|t| t[s].0.clone()).collect();
+        let pos: Vec<f32> = per_take.iter().flat_map(|t| t[s].0.clone()).collect();
         let mut neg: Vec<f32> = per_take.iter().flat_map(|t| t[s].1.clone()).collect();
         neg.sort_by(f32::total_cmp);
-        pos.sort_by(f32::total_cmp);
         let at = |q: f64| {
             let cut = neg[((neg.len() as f64) * q) as usize];
             pos.iter().filter(|&&v| v > cut).count() as f64 / pos.len() as f64
@@ -472,5 +430,4 @@ fn subtree_level(takes: &[mocap_clean::dataset::Take], model: &CleanModel) {
             at(0.999)
         );
     }
-    println!();
 }

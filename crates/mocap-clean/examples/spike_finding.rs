@@ -20,18 +20,14 @@ mod support;
 
 use std::time::Instant;
 
-use mocap_clean::dataset::looped_window;
 use mocap_clean::despike::{
     bridge_spikes, find_spikes, normalised_jumps, DespikeOptions, FoundSpike,
 };
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::{add_random_noise, add_spike_noise, RandomNoise, SpikeNoise};
 use mocap_core::rotation::angle_between;
 use mocap_core::Motion;
-use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 struct TakeResult {
@@ -103,25 +99,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let results: Vec<TakeResult> = (0..takes.len())
         .into_par_iter()
         .map(|i| {
-            let key = u32::MAX as u64;
-            let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+            let support::SpikedTake {
+                noisy,
+                spiked,
+                spikes,
+            } = support::spiked_take(&takes, i, None);
             let clean = &takes[i].motion;
             let n = clean.frame_count();
-            let noisy = add_random_noise(clean, &RandomNoise::default(), &mut rng).0;
-            let donors: Vec<Motion> = (0..3)
-                .map(|_| {
-                    let mut d = rng.random_range(0..takes.len());
-                    if d == i {
-                        d = (d + 1) % takes.len();
-                    }
-                    let donor = &takes[d].motion;
-                    looped_window(donor, rng.random_range(0..donor.frame_count()), n)
-                })
-                .collect();
-            let donor_refs: Vec<&Motion> = donors.iter().collect();
-            let (spiked, spikes) =
-                add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
-                    .expect("spikes");
             let (cleaned, spiked_level) = model.clean_reporting(&spiked, None).expect("clean");
             let (_, noisy_level) = model.clean_reporting(&noisy, None).expect("clean");
             let looked_at = |signal: usize| [&cleaned, &spiked][signal];

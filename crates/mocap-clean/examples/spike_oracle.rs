@@ -39,19 +39,14 @@ mod support;
 
 use std::time::Instant;
 
-use mocap_clean::dataset::looped_window;
 use mocap_clean::despike::{bridge_spikes, remove_spikes, DespikeOptions, FoundSpike};
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::{
-    add_random_noise, add_random_noise_sigma, add_spike_noise, RandomNoise, Spike, SpikeNoise,
-};
+use mocap_clean::noise::Spike;
 use mocap_clean::wiener::WienerFilter;
 use mocap_core::Motion;
-use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 
 /// The methods, in table order.
@@ -99,30 +94,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let per_take: Vec<[f64; METHODS.len()]> = (0..takes.len())
             .into_par_iter()
             .map(|i| {
-                let key = level.map_or(u32::MAX, f32::to_bits) as u64;
-                let mut rng = ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+                let support::SpikedTake {
+                    noisy,
+                    spiked,
+                    spikes,
+                } = support::spiked_take(&takes, i, level);
                 let clean = &takes[i].motion;
                 let n = clean.frame_count();
-                let noisy = match level {
-                    Some(sigma) => {
-                        add_random_noise_sigma(clean, sigma, &RandomNoise::default(), &mut rng)
-                    }
-                    None => add_random_noise(clean, &RandomNoise::default(), &mut rng).0,
-                };
-                let donors: Vec<Motion> = (0..3)
-                    .map(|_| {
-                        let mut d = rng.random_range(0..takes.len());
-                        if d == i {
-                            d = (d + 1) % takes.len();
-                        }
-                        let donor = &takes[d].motion;
-                        looped_window(donor, rng.random_range(0..donor.frame_count()), n)
-                    })
-                    .collect();
-                let donor_refs: Vec<&Motion> = donors.iter().collect();
-                let (spiked, spikes) =
-                    add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
-                        .expect("spikes");
                 let found: Vec<FoundSpike> = spikes
                     .iter()
                     .map(

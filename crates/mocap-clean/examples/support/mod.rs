@@ -50,3 +50,51 @@ impl StudyArgs {
         Ok(load_takes(&paths[..self.takes.min(paths.len())])?)
     }
 }
+
+/// A validation take with the spike studies' noise: random noise (of level
+/// `sigma_deg`, or drawn in 0-10 degrees), then 1-3 spikes from other takes.
+#[allow(dead_code)] // not every study adds spikes
+pub struct SpikedTake {
+    /// With the random noise only.
+    pub noisy: mocap_core::Motion,
+    /// `noisy` with the spikes.
+    pub spiked: mocap_core::Motion,
+    pub spikes: Vec<mocap_clean::noise::Spike>,
+}
+
+/// Take `i` of `takes` with the spike studies' noise, seeded by `i` and the
+/// level, so that every study sees the same noisy takes.
+#[allow(dead_code)] // not every study adds spikes
+pub fn spiked_take(takes: &[Take], i: usize, sigma_deg: Option<f32>) -> SpikedTake {
+    use mocap_clean::dataset::looped_window;
+    use mocap_clean::noise::{
+        add_random_noise, add_random_noise_sigma, add_spike_noise, RandomNoise, SpikeNoise,
+    };
+    use rand::{RngExt, SeedableRng};
+    let key = sigma_deg.map_or(u32::MAX, f32::to_bits) as u64;
+    let mut rng = rand::rngs::ChaCha8Rng::seed_from_u64(0x5e1ce ^ (i as u64) << 16 ^ key);
+    let clean = &takes[i].motion;
+    let n = clean.frame_count();
+    let noisy = match sigma_deg {
+        Some(sigma) => add_random_noise_sigma(clean, sigma, &RandomNoise::default(), &mut rng),
+        None => add_random_noise(clean, &RandomNoise::default(), &mut rng).0,
+    };
+    let donors: Vec<mocap_core::Motion> = (0..3)
+        .map(|_| {
+            let mut d = rng.random_range(0..takes.len());
+            if d == i {
+                d = (d + 1) % takes.len();
+            }
+            let donor = &takes[d].motion;
+            looped_window(donor, rng.random_range(0..donor.frame_count()), n)
+        })
+        .collect();
+    let donor_refs: Vec<&mocap_core::Motion> = donors.iter().collect();
+    let (spiked, spikes) = add_spike_noise(&noisy, &donor_refs, &SpikeNoise::default(), &mut rng)
+        .expect("spikes from takes of the same rig");
+    SpikedTake {
+        noisy,
+        spiked,
+        spikes,
+    }
+}
