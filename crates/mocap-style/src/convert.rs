@@ -25,7 +25,11 @@
 //! 5. Strength: the output latent is `(1 - s(t)) x(warp(t)) + s(t) y(t)`
 //!    with `s(t) = strength * min(1, t / fade_in)`; two styles blend as
 //!    `sum_k w_k y_k(t)`, the stretch of a patch being chosen by the weighted
-//!    sum of the styles' similarities so both share one timing.
+//!    sum of the styles' similarities so both share one timing. The timing
+//!    is interpolated too: the output's clock runs at the source's pace
+//!    where `s = 0` and at the style's where `s = 1`, so at strength 0.5 an
+//!    elastic output lasts about halfway between the source and the full
+//!    style.
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
 //! the whitened source frames with the style's statistics without any
@@ -259,7 +263,8 @@ pub type StyleMatch = (usize, usize, f32);
 pub struct PatchMatch {
     /// 1: the main series; 2: the series offset by half a patch.
     pub series: u8,
-    /// First output frame of the patch.
+    /// First output frame of the patch (where the strength slows or
+    /// speeds the timing, the output frame its styled frame falls on).
     pub output_start: usize,
     /// First source frame (fractional) and source frames taken.
     pub source_start: f32,
@@ -441,27 +446,71 @@ pub fn convert(
     };
 
     // Strength and fade-in: interpolate between the (time-warped) source and
-    // the converted latent.
-    let frames = source_time.len();
-    let mut data = vec![0.0; frames * dim];
-    let mut height = vec![0.0; frames];
-    let mut strength = vec![0.0; frames];
-    let mut x = vec![0.0; dim];
-    for o in 0..frames {
+    // the converted latent, and between the source's timing and the style's.
+    // On the styled timeline (frame `o` of the patches, source time `T(o)`)
+    // the strength is `s(o) = strength * min(1, o / fade_in)`, and the output
+    // clock advances by `(1 - s) (T(o + 1) - T(o)) + s` per styled frame:
+    // the source's pace at strength 0, the style's at 1 (where the clock is
+    // the styled timeline itself).
+    let strength_at = |o: f32| {
         let fade = if options.fade_in_frames > 0.0 {
-            (o as f32 / options.fade_in_frames).min(1.0)
+            (o / options.fade_in_frames).min(1.0)
         } else {
             1.0
         };
-        let s = options.strength * fade;
-        strength[o] = s;
-        source.sample(source_time[o], &mut x);
-        for c in 0..dim {
-            data[o * dim + c] = (1.0 - s) * x[c] + s * converted[o * dim + c];
-        }
-        height[o] =
-            (1.0 - s) * sample_track(source_height, source_time[o]) + s * converted_height[o];
+        options.strength * fade
+    };
+    let styled = source_time.len();
+    let mut clock = vec![0.0f32; styled];
+    for o in 1..styled {
+        let s = strength_at((o - 1) as f32);
+        clock[o] = clock[o - 1] + (1.0 - s) * (source_time[o] - source_time[o - 1]) + s;
     }
+    let frames = clock[styled - 1].round() as usize + 1;
+    let mut data = vec![0.0; frames * dim];
+    let mut height = vec![0.0; frames];
+    let mut strength = vec![0.0; frames];
+    let mut output_time = vec![0.0; frames];
+    let mut x = vec![0.0; dim];
+    let mut o = 0;
+    for q in 0..frames {
+        // The styled frames `o`, `o + 1` around output frame `q`, and where
+        // between them it falls.
+        let t = q as f32;
+        while o + 2 < styled && clock[o + 1] <= t {
+            o += 1;
+        }
+        let next = (o + 1).min(styled - 1);
+        let span = clock[next] - clock[o];
+        let a = if span > 0.0 {
+            ((t - clock[o]) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let u = if a >= 1.0 {
+            source_time[next]
+        } else {
+            source_time[o] + a * (source_time[next] - source_time[o])
+        };
+        let s = strength_at(o as f32 + a);
+        output_time[q] = u;
+        strength[q] = s;
+        source.sample(u, &mut x);
+        for c in 0..dim {
+            let y = (1.0 - a) * converted[o * dim + c] + a * converted[next * dim + c];
+            data[q * dim + c] = (1.0 - s) * x[c] + s * y;
+        }
+        let y_height = (1.0 - a) * converted_height[o] + a * converted_height[next];
+        height[q] = (1.0 - s) * sample_track(source_height, u) + s * y_height;
+    }
+    let source_time = output_time;
+    let matches = matches
+        .into_iter()
+        .map(|m| PatchMatch {
+            output_start: clock[m.output_start.min(styled - 1)].round() as usize,
+            ..m
+        })
+        .collect();
     Ok(Conversion {
         latents: Latents::new(frames, dim, data)?,
         source_time,
@@ -724,6 +773,54 @@ mod tests {
         )
         .unwrap();
         assert_eq!(fixed.latents.frames, 300);
+    }
+
+    #[test]
+    fn the_strength_interpolates_the_timing_too() {
+        let x = periodic(300, 30.0, 0.3);
+        let y = style_of(periodic(240, 38.0, 0.0));
+        let h = vec![90.0; 300];
+        let style = [StyleInput {
+            sequences: &y,
+            weight: 1.0,
+        }];
+        let at = |strength: f32| {
+            convert(
+                &x,
+                &h,
+                &style,
+                &ConvertOptions {
+                    strength,
+                    ..ConvertOptions::default()
+                },
+            )
+            .unwrap()
+        };
+        let (none, half, full) = (at(0.0), at(0.5), at(1.0));
+        // Strength 0: the source, frame for frame.
+        assert!(
+            none.latents.frames.abs_diff(300) <= 1,
+            "{}",
+            none.latents.frames
+        );
+        let off = none
+            .latents
+            .data
+            .iter()
+            .zip(&x.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(off < 1e-3, "{off}");
+        // Half: a duration about halfway, and the warp still increasing.
+        let middle = (300 + full.latents.frames) as f32 / 2.0;
+        let frames = half.latents.frames as f32;
+        assert!((frames - middle).abs() < 3.0, "{frames} against {middle}");
+        assert!(half.source_time.windows(2).all(|w| w[1] > w[0]));
+        assert!(*half.source_time.last().unwrap() > 290.0);
+        assert!(half.strength.iter().all(|&s| s == 0.5));
+        // The patches' output frames move with the timing.
+        let last = |c: &Conversion| c.matches.iter().map(|m| m.output_start).max().unwrap();
+        assert!(last(&none) < last(&half) && last(&half) < last(&full));
     }
 
     #[test]

@@ -84,7 +84,8 @@ struct ApplyArgs {
     /// The autoencoder (default: the model shipped with mocap).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// 1: full style, 0: the source.
+    /// 1: full style, 0: the source; in between, the pose and (with elastic patches) the timing are
+    /// interpolated, so 0.5 lasts about halfway between the source and the full style.
     #[arg(long, default_value_t = 1.0)]
     strength: f32,
     /// Fixed patches instead of elastic ones (the style's timing is not carried over).
