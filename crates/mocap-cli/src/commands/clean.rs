@@ -317,8 +317,15 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.mean_change_deg,
             report.frames_per_second
         );
+        const LISTED: usize = 20;
         let list = |spikes: &[BridgedSpike]| {
-            for s in spikes {
+            if spikes.len() > LISTED {
+                eprintln!(
+                    "  (the first {LISTED} of {}; --json lists them all)",
+                    spikes.len()
+                );
+            }
+            for s in spikes.iter().take(LISTED) {
                 eprintln!(
                     "  {} and below: frames {}-{} ({:.2}-{:.2} s)",
                     s.joint,
