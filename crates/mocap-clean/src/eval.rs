@@ -165,7 +165,7 @@ pub struct EvalReport {
     pub entries: Vec<MethodMetrics>,
     pub tuned_filters: Vec<TunedFilter>,
     /// The spike finding settings chosen on the validation takes for each
-    /// method (`METHOD + despike`), with the mean rotation error they gave
+    /// method (`despike + METHOD`), with the mean rotation error they gave
     /// there (spike condition), when asked.
     #[serde(default)]
     pub tuned_despike: Vec<(String, DespikeOptions, f64)>,

@@ -13,8 +13,8 @@
 //!
 //! - [`noise`]: the two noise models (chain-corrected random noise, spikes);
 //! - [`features`]: rotation representations fed to the network;
-//! - [`despike`]: finding spikes by the jumps at their ends and bridging
-//!   them, a classical stage after a denoiser;
+//! - [`despike`]: finding spikes by the jumps of global rotations at their
+//!   ends and bridging them, a classical stage before a filter or denoiser;
 //! - [`spikes`]: a learned spike detector (the network with one output per
 //!   joint and frame) and bridging of what it marks, a stage before a
 //!   denoiser;

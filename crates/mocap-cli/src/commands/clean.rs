@@ -66,7 +66,7 @@ struct TakeArgs {
     #[arg(long)]
     despike: bool,
     /// Only find and bridge spikes (with --despike), no denoising: for takes with spikes and little
-    /// random noise, whose spikes the shipped model takes for noise (see bench/results/clean.md).
+    /// random noise (see bench/results/clean.md).
     #[arg(long, requires = "despike", conflicts_with_all = ["model", "filter"])]
     despike_only: bool,
     /// Spike finding: a boundary is a subtree jump this many times the joints' upper-quartile jump
@@ -226,7 +226,8 @@ struct EvalArgs {
     /// Leave out the classical filters.
     #[arg(long)]
     no_filters: bool,
-    /// Also follow every method by spike finding (tuned per method on validation takes).
+    /// Also run every method after spike finding on the noisy input (settings tuned per method on
+    /// validation takes).
     #[arg(long)]
     despike: bool,
     /// Also run this learned spike detector (from `mocap clean train --spike-detector`) alone and
