@@ -690,9 +690,20 @@ mod tests {
         Latents::new(frames, dim, data).unwrap()
     }
 
-    fn style_of(latents: Latents) -> Vec<(Latents, Vec<f32>)> {
+    /// A style's sequences: latent codes and root height per frame.
+    type Sequences = Vec<(Latents, Vec<f32>)>;
+
+    fn style_of(latents: Latents) -> Sequences {
         let h = vec![90.0; latents.frames];
         vec![(latents, h)]
+    }
+
+    /// A 300-frame source stepping every 30 frames, a style stepping every
+    /// 38, and the source's root height.
+    fn stepping_every_30_and_38() -> (Latents, Sequences, Vec<f32>) {
+        let x = periodic(300, 30.0, 0.3);
+        let y = style_of(periodic(240, 38.0, 0.0));
+        (x, y, vec![90.0; 300])
     }
 
     #[test]
@@ -746,9 +757,7 @@ mod tests {
     /// about 38/30 as long; fixed patches keep the length.
     #[test]
     fn elastic_patches_take_the_style_timing() {
-        let x = periodic(300, 30.0, 0.3);
-        let y = style_of(periodic(240, 38.0, 0.0));
-        let h = vec![90.0; 300];
+        let (x, y, h) = stepping_every_30_and_38();
         let style = [StyleInput {
             sequences: &y,
             weight: 1.0,
@@ -777,9 +786,7 @@ mod tests {
 
     #[test]
     fn the_strength_interpolates_the_timing_too() {
-        let x = periodic(300, 30.0, 0.3);
-        let y = style_of(periodic(240, 38.0, 0.0));
-        let h = vec![90.0; 300];
+        let (x, y, h) = stepping_every_30_and_38();
         let style = [StyleInput {
             sequences: &y,
             weight: 1.0,
