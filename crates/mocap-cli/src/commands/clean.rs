@@ -76,6 +76,9 @@ struct TakeArgs {
     /// Spike finding: frames averaged on each side of a boundary (default 1).
     #[arg(long, requires = "despike")]
     despike_span: Option<usize>,
+    /// Spike finding: the longest spike looked for, in frames (default 90).
+    #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
+    despike_max_frames: Option<usize>,
     /// Before cleaning, find spikes (a joint and its subtree taking another motion's rotations) with
     /// this learned detector, written by `mocap clean train --spike-detector`, and bridge them.
     /// Experimental, none ships: see bench/results/clean.md.
@@ -290,6 +293,7 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         let mut d = DespikeOptions::default();
         set(&mut d.threshold, a.despike_threshold);
         set(&mut d.span, a.despike_span);
+        set(&mut d.max_frames, a.despike_max_frames);
         d
     });
     let find_spikes = a.spike_model.map(|model| {
@@ -527,6 +531,15 @@ fn degrees_at_least_zero(text: &str) -> Result<f32, String> {
         Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
         _ => Err(format!(
             "expected a number of degrees, 0 or more, got `{text}`"
+        )),
+    }
+}
+
+fn frames_at_least_one(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(v) if v >= 1 => Ok(v),
+        _ => Err(format!(
+            "expected a number of frames, 1 or more, got `{text}`"
         )),
     }
 }
