@@ -6,7 +6,8 @@
 //! for either in the shipped model's output (as sessions 4-8 did) or in the
 //! noisy input (as `mocap clean --despike` does now), on local or global
 //! rotations ([`DespikeOptions::global`]), with a grid of spans and
-//! thresholds; they are bridged in the input and the model runs on it. Printed: the mean
+//! thresholds (and of the longest spike looked for, on global rotations in
+//! the input); they are bridged in the input and the model runs on it. Printed: the mean
 //! rotation error of each setting, two oracles (the true spikes bridged; the
 //! model at the noise level estimated without spikes), the best fixed filter
 //! of the evaluation's spike condition (Butterworth, 2 Hz), and, for the old and
@@ -52,7 +53,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = CleanModel::load_default(Default::default())?;
     let takes = args.validation_takes()?;
     // (label, where spikes are looked for: 0 the model's output, 1 the
-    // noisy input; options)
+    // noisy input; options). Spikes up to 90 frames long (sessions 4-8's
+    // longest), then the longest spike varied.
     let mut settings: Vec<(String, usize, Option<DespikeOptions>)> =
         vec![("no spike finding".to_string(), 0, None)];
     for (signal, place) in [(0, "model output"), (1, "input")] {
@@ -69,11 +71,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             span,
                             threshold,
                             global,
-                            ..DespikeOptions::default()
+                            max_frames: 90,
                         }),
                     ));
                 }
             }
+        }
+    }
+    // The longest spike looked for, on the best of the above.
+    for max_frames in [24, 30, 45, 60] {
+        for threshold in [2.5f32, 3.0] {
+            settings.push((
+                format!(
+                    "input, global rotations, span 1, threshold {threshold}, longest spike {max_frames} frames"
+                ),
+                1,
+                Some(DespikeOptions {
+                    span: 1,
+                    threshold,
+                    global: true,
+                    max_frames,
+                }),
+            ));
         }
     }
     // The spikes of these two are sorted: sessions 4-8's setting and the
@@ -86,7 +105,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 span: 3,
                 threshold: 3.0,
                 global: false,
-                ..DespikeOptions::default()
+                max_frames: 90,
             },
         ),
         (

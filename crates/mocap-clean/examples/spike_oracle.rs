@@ -163,7 +163,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     threshold: 3.0,
                     span: 3,
                     global: false,
-                    ..DespikeOptions::default()
+                    max_frames: 90,
                 };
                 let (found_bridged_after, found_after) =
                     remove_spikes(&model.clean(&spiked, None).expect("clean"), &on_output);
