@@ -215,7 +215,7 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
     let inside_above = |s: &FoundSpike| {
         spikes.iter().any(|a| {
             a.joint != s.joint
-                && skeleton.subtree(a.joint).contains(&s.joint)
+                && subtrees[a.joint].contains(&s.joint)
                 && a.start <= s.start
                 && s.start + s.frames <= a.start + a.frames
         })

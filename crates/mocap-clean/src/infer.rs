@@ -265,7 +265,7 @@ impl CleanModel {
                     let around = padded_filtered
                         .as_deref()
                         .map(|take| &take[s * c..(s + t) * c]);
-                    window_base(&w, around, &recentering, base, c)
+                    window_base(&w, around, &recentering, base, c, level_deg)
                 });
                 offsets.push(recentering);
                 if let Some((filtered, window_level)) = filtered {
@@ -548,6 +548,12 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         }
     };
     write_bvh(&options.output, &cleaned)?;
+    let reported = |spikes: &[FoundSpike]| -> Vec<BridgedSpike> {
+        spikes
+            .iter()
+            .map(|s| BridgedSpike::new(&original, s))
+            .collect()
+    };
     let frames = motion.frame_count();
     let seconds = seconds + detect_seconds;
     Ok(CleanReport {
@@ -558,14 +564,8 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         seconds,
         frames_per_second: frames as f64 / seconds.max(1e-9),
         mean_change_deg: crate::eval::rotation_error_deg(&original, &cleaned),
-        spikes: spikes
-            .iter()
-            .map(|s| BridgedSpike::new(&original, s))
-            .collect(),
-        detected_spikes: detected_spikes
-            .iter()
-            .map(|s| BridgedSpike::new(&original, s))
-            .collect(),
+        spikes: reported(&spikes),
+        detected_spikes: reported(&detected_spikes),
     })
 }
 

@@ -498,7 +498,7 @@ impl<'a> WindowSampler<'a> {
                         crop(&filtered)
                     });
                     let (base, window_level) =
-                        window_base(&xf, around.as_deref(), &recentering, base, c);
+                        window_base(&xf, around.as_deref(), &recentering, base, c, None);
                     // The network's output N(x) stands for y - base(x) + x,
                     // so that the model's output N(x) - x + base(x) is y.
                     for ((y, x), b) in yf.iter_mut().zip(&xf).zip(&base) {
@@ -532,13 +532,15 @@ impl<'a> WindowSampler<'a> {
 /// [`ModelDescription::base_context`]): `filtered_around` is the same frames
 /// cut from the filter's output over a longer stretch (the take around the
 /// window), brought here onto the window's branch; without it the filter
-/// runs on the window itself.
+/// runs on the window itself, at noise level `level_deg` when given (else
+/// the one it estimates there).
 pub(crate) fn window_base(
     window: &[f32],
     filtered_around: Option<&[f32]>,
     recentering: &Recentering,
     base: &Base,
     channels: usize,
+    level_deg: Option<f64>,
 ) -> (Vec<f32>, Option<f64>) {
     match filtered_around {
         Some(around) => {
@@ -548,7 +550,7 @@ pub(crate) fn window_base(
         }
         None => {
             let mut filtered = window.to_vec();
-            let level = base.apply(&mut filtered, channels, None);
+            let level = base.apply(&mut filtered, channels, level_deg);
             (filtered, level)
         }
     }
@@ -1310,6 +1312,11 @@ mod tests {
             "{off} degrees from the Wiener filter at 1 degree"
         );
         assert!(crate::eval::rotation_error_deg(&filtered_at_level, &filtered) > 0.01);
+        // So it does when the filter runs on each window alone.
+        model.description.base_context = 0;
+        let per_window = |level: f64| model.clean_at_level(&noisy, None, Some(level)).unwrap();
+        let ((low, _), (high, _)) = (per_window(1.0), per_window(8.0));
+        assert!(crate::eval::rotation_error_deg(&low, &high) > 0.01);
         // Not both bases, and not on features a Wiener filter cannot read.
         std::fs::rename(&kept, &wiener_path).unwrap();
         for (wrong, why) in [

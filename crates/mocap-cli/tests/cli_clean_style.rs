@@ -172,22 +172,21 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
         "median:3",
     ]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    // A longest spike of no frames is a usage error naming the option.
-    let out = mocap(&[
-        "clean",
-        &input,
-        "-o",
-        path(&output),
-        "--despike",
-        "--despike-max-frames",
-        "0",
-    ]);
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("--despike-max-frames"),
-        "{}",
-        stderr(&out)
-    );
+    // A span or longest spike of no frames is a usage error naming the
+    // option.
+    for option in ["--despike-span", "--despike-max-frames"] {
+        let out = mocap(&[
+            "clean",
+            &input,
+            "-o",
+            path(&output),
+            "--despike",
+            option,
+            "0",
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+        assert!(stderr(&out).contains(option), "{}", stderr(&out));
+    }
 
     // A denoiser given as spike detector is an input error naming the file.
     let model = mocap_testdata::repo_root().join("models/clean-default.safetensors");

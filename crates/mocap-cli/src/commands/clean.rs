@@ -74,7 +74,7 @@ struct TakeArgs {
     #[arg(long, requires = "despike")]
     despike_threshold: Option<f32>,
     /// Spike finding: frames averaged on each side of a boundary (default 1).
-    #[arg(long, requires = "despike")]
+    #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
     despike_span: Option<usize>,
     /// Spike finding: the longest spike looked for, in frames (default 90).
     #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
@@ -524,7 +524,6 @@ fn parse_lengths(text: &str) -> anyhow::Result<Vec<usize>> {
         .collect()
 }
 
-/// Overrides a default when the option was given.
 /// Parses a noise level: a finite number of degrees, zero or more.
 fn degrees_at_least_zero(text: &str) -> Result<f32, String> {
     match text.parse::<f32>() {
@@ -535,6 +534,7 @@ fn degrees_at_least_zero(text: &str) -> Result<f32, String> {
     }
 }
 
+/// Parses a number of frames, one or more.
 fn frames_at_least_one(text: &str) -> Result<usize, String> {
     match text.parse::<usize>() {
         Ok(v) if v >= 1 => Ok(v),
@@ -544,6 +544,7 @@ fn frames_at_least_one(text: &str) -> Result<usize, String> {
     }
 }
 
+/// Overrides a default when the option was given.
 fn set<T>(slot: &mut T, value: Option<T>) {
     if let Some(v) = value {
         *slot = v;
