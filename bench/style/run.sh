@@ -7,7 +7,8 @@
 #   bash bench/style/run.sh --classifiers  # also compare the evaluation's classifiers
 #                                          # on real clips (held out + cross-validation)
 #   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
-#   bash bench/style/run.sh --contacts # also patches with foot-contact cleanup (opt-in)
+#   bash bench/style/run.sh --contacts # also patches with foot-contact cleanup and with
+#                                      # the root carried by the feet (both opt-in)
 # (flags combine)
 #
 # Build profile: `--profile test` (dependencies at opt-level 2 from the dev
@@ -78,4 +79,12 @@ if flag --contacts; then
   "$BIN/style_eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
     --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-contacts.json" \
     --markdown "$OUT/eval-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  # The root carried by the planted feet instead of the source's path
+  # (`--root-from-feet`), alone and followed by the cleanup.
+  "$BIN/style_eval" --root-from-feet --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-root-from-feet.json" \
+    --markdown "$OUT/eval-root-from-feet.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  "$BIN/style_eval" --root-from-feet --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-root-from-feet-contacts.json" \
+    --markdown "$OUT/eval-root-from-feet-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 fi

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use mocap_core::io::bvh::read_bvh;
+use mocap_style::eval::foot_skating;
+use mocap_style::features::RigLayout;
 
 fn mocap(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mocap"))
@@ -430,6 +432,42 @@ fn style_apply_restyles_the_bundled_walk() {
         (0.8 - 1e-9..=1.0 / 0.75 + 1e-9).contains(&scale),
         "time scale {scale}"
     );
+
+    // With the root carried by the planted feet the same restyle slides its
+    // feet less, and says how far they carried it.
+    let full = |extra: &[&str]| {
+        let mut args = vec![
+            "style",
+            "apply",
+            &source,
+            "--style",
+            &style,
+            "-o",
+            path(&output),
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = mocap(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (report, read_bvh(&output).unwrap())
+    };
+    let (path_report, path_motion) = full(&[]);
+    let (feet_report, feet_motion) = full(&["--root-from-feet"]);
+    assert_eq!(feet_report["root_from_feet"], true);
+    assert_eq!(path_motion.frame_count(), feet_motion.frame_count());
+    let rig = RigLayout::from_skeleton(path_motion.skeleton()).unwrap();
+    let (sliding, carried) = (
+        foot_skating(&path_motion, &rig),
+        foot_skating(&feet_motion, &rig),
+    );
+    assert!(
+        carried < 0.85 * sliding,
+        "foot skating {sliding} -> {carried}"
+    );
+    assert!((path_report["distance_ratio"].as_f64().unwrap() - 1.0).abs() < 0.02);
+    let ratio = feet_report["distance_ratio"].as_f64().unwrap();
+    assert!((0.7..1.3).contains(&ratio), "distance ratio {ratio}");
 
     // A bad duration and a missing style clip are input errors (1).
     let out = mocap(&[

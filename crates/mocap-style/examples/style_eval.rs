@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release -p mocap-style --example style_eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
-//!     [--classifier-contents walk,walk-back] [--patch 32] [--foot-contacts] [--filmstrips DIR] \
+//!     [--classifier-contents walk,walk-back] [--patch 32] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...
 //! ```
 
@@ -30,6 +30,7 @@ fn main() {
             "--styles" => options.style_contents = list(value()),
             "--classifier-contents" => options.classifier_filter.contents = list(value()),
             "--foot-contacts" => options.convert.foot_contacts = true,
+            "--root-from-feet" => options.convert.root_from_feet = true,
             "--patch" => options.convert.patch = value().parse().expect("--patch N"),
             "--style-descriptor" => {
                 options.style_descriptor = serde_json::from_value(serde_json::json!(value()))

@@ -55,7 +55,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| method | total (ms) | prepare | encode | match | decode | compose | output frames |"
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
-    for method in [Method::ElasticPatches, Method::FixedPatches] {
+    for (method, root_from_feet) in [
+        (Method::ElasticPatches, false),
+        (Method::FixedPatches, false),
+        (Method::ElasticPatches, true),
+    ] {
         let mut all: Vec<StageTimings> = Vec::new();
         let mut out_frames = 0;
         for _ in 0..runs + 1 {
@@ -63,6 +67,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let clip = prepare_style(&model, &style_motion, "style", &mut t)?;
             let options = ConvertOptions {
                 method,
+                root_from_feet,
                 ..ConvertOptions::default()
             };
             let r = restyle(&model, &source, &[(&clip, 1.0)], &options, t)?;
@@ -74,8 +79,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let total = ms(&|t| t.total());
         let share = |v: f64| format!("{v:.1} ms ({:.0}%)", 100.0 * v / total);
         println!(
-            "| {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| {}{} | {:.1} | {} | {} | {} | {} | {} | {} |",
             method.name(),
+            if root_from_feet {
+                ", root from feet"
+            } else {
+                ""
+            },
             total,
             share(ms(&|t| t.prepare)),
             share(ms(&|t| t.encode)),

@@ -7,7 +7,9 @@
 //! The root's horizontal path and heading come from the source (time-warped
 //! with the patches), its height from the style clip, scaled by the ratio of
 //! the two performers' leg lengths (heights are measured from the world
-//! origin, i.e. the ground of the capture). A style clip must be of the same
+//! origin, i.e. the ground of the capture). With `root_from_feet` the
+//! horizontal path is instead carried by the output's own planted feet, so
+//! they do not slide ([`crate::contact`]). A style clip must be of the same
 //! rig as the source (same joint names and hierarchy; other bone lengths are
 //! fine); another rig is refused with a message that names the differences:
 //! retargeting between rigs is not done here.
@@ -23,7 +25,9 @@ use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
-use crate::contact::{clean_foot_contacts, ContactOptions};
+use crate::contact::{
+    clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions,
+};
 use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, StyleInput};
 use crate::data::mirrored;
 use crate::features::{compose, decompose, sample_frames, RootTrack};
@@ -49,6 +53,14 @@ pub struct ApplyOptions {
     pub blend: Option<(PathBuf, f32)>,
     /// Patch length in frames (default 32).
     pub patch: usize,
+    /// Move the root with the planted feet instead of along the source's
+    /// path ([`crate::contact::root_from_feet`]).
+    #[serde(default)]
+    pub root_from_feet: bool,
+    /// Pin the ankles on the ground by turning hips and knees
+    /// ([`crate::contact::clean_foot_contacts`]).
+    #[serde(default)]
+    pub foot_contacts: bool,
     pub device: DeviceChoice,
 }
 
@@ -69,6 +81,8 @@ impl ApplyOptions {
             fade_in_seconds: 0.0,
             blend: None,
             patch: ConvertOptions::default().patch,
+            root_from_feet: false,
+            foot_contacts: false,
             device: DeviceChoice::Cpu,
         }
     }
@@ -217,6 +231,9 @@ pub fn restyle(
     let t = Instant::now();
     let out_rotations = model.description.normalization.rotations(&decoded);
     let mut motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
+    if options.root_from_feet {
+        root_from_feet(&mut motion, rig, &RootFromFeetOptions::default());
+    }
     if options.foot_contacts {
         clean_foot_contacts(&mut motion, rig, &ContactOptions::default());
     }
@@ -266,11 +283,18 @@ pub struct ApplyReport {
     pub strength: f32,
     pub fade_in_seconds: f64,
     pub patch: usize,
+    pub root_from_feet: bool,
+    pub foot_contacts: bool,
     pub source_frames: usize,
     pub output_frames: usize,
     pub fps: f64,
     /// Output duration over source duration (1 without elastic patches).
     pub time_scale: f64,
+    /// Horizontal distance the pelvis travels in the output over the
+    /// distance it travels in the source (1 up to sampling when the root
+    /// follows the source's path; the strides set it with
+    /// `root_from_feet`).
+    pub distance_ratio: f64,
     /// Mean source frames per patch over the patch length (main series).
     pub mean_patch_stretch: f64,
     /// Mean cosine similarity of the matched patches.
@@ -350,6 +374,8 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         patch: options.patch,
         strength: options.strength,
         fade_in_frames: (options.fade_in_seconds * model.description.fps) as f32,
+        root_from_feet: options.root_from_feet,
+        foot_contacts: options.foot_contacts,
         ..ConvertOptions::default()
     };
     // Check the source's rig first so its message names the source file.
@@ -392,10 +418,14 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         strength: options.strength,
         fade_in_seconds: options.fade_in_seconds,
         patch: options.patch,
+        root_from_feet: options.root_from_feet,
+        foot_contacts: options.foot_contacts,
         source_frames: source.frame_count(),
         output_frames: restyled.motion.frame_count(),
         fps: restyled.motion.fps(),
         time_scale: restyled.motion.duration() / source.duration(),
+        distance_ratio: (travelled(&restyled.motion, &model.description.rig)
+            / travelled(&source, &model.description.rig)) as f64,
         mean_patch_stretch,
         mean_similarity: if sims.is_empty() {
             f64::NAN

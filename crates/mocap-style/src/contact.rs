@@ -9,9 +9,15 @@
 //! reaches the held place by turning the hip and knee (two-bone inverse
 //! kinematics). The ankle keeps its global orientation, so the foot and toes
 //! keep the style's roll; the root and the upper body are not touched.
+//!
+//! [`root_from_feet`] attacks the same sliding from the other side: it
+//! leaves every joint rotation alone and moves the root instead, so that the
+//! feet on the ground stand still and the body is carried by its strides
+//! (root motion taken from the feet, as games drive a character). The path
+//! then follows the style's strides rather than the source's.
 
 use mocap_core::rotation::{Quat, Vec3};
-use mocap_core::{forward_kinematics, Motion};
+use mocap_core::{forward_kinematics, GlobalPoses, Motion};
 
 use crate::features::{up_axis, RigLayout};
 
@@ -64,22 +70,19 @@ pub fn clean_foot_contacts(
         }
         let up = up_axis(&poses.positions, poses.joint_count, rig);
         let tolerance = options.height_tolerance * rig.leg_length(motion.skeleton());
-        let heights: Vec<f32> = (0..n).map(|f| poses.position(f, ankle).dot(up)).collect();
-        let mut sorted = heights.clone();
-        sorted.sort_by(|a, b| a.total_cmp(b));
-        let ground = sorted[(n - 1) * 2 / 100];
+        let heights = heights_above_ground(&poses, ankle, up);
         let horizontal = |p: Vec3| p - up * p.dot(up);
         // Horizontal offset of the held place from the ankle, per frame.
         let mut offset = vec![Vec3::ZERO; n];
         let mut weight = vec![0.0f32; n];
         let mut f = 0;
         while f < n {
-            if heights[f] > ground + tolerance {
+            if heights[f] > tolerance {
                 f += 1;
                 continue;
             }
             let start = f;
-            while f < n && heights[f] <= ground + tolerance {
+            while f < n && heights[f] <= tolerance {
                 f += 1;
             }
             let end = f; // exclusive
@@ -134,6 +137,183 @@ pub fn clean_foot_contacts(
         }
     }
     changed
+}
+
+/// Height of `joint` above its own ground on every frame: its height along
+/// `up` minus its lowest height in the clip, taken as the 2nd percentile so
+/// a stray frame does not set it. A foot joint is on the ground where this
+/// is within a tolerance (5% of the leg length throughout this crate).
+pub(crate) fn heights_above_ground(poses: &GlobalPoses, joint: usize, up: Vec3) -> Vec<f32> {
+    let n = poses.frame_count;
+    let heights: Vec<f32> = (0..n).map(|f| poses.position(f, joint).dot(up)).collect();
+    if n == 0 {
+        return heights;
+    }
+    let mut sorted = heights.clone();
+    sorted.sort_by(|a, b| a.total_cmp(b));
+    let ground = sorted[(n - 1) * 2 / 100];
+    heights.into_iter().map(|h| h - ground).collect()
+}
+
+/// Settings of [`root_from_feet`]. Lengths are fractions of the leg length,
+/// so they hold for any rig and unit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RootFromFeetOptions {
+    /// The feet lead the root while the lowest foot joint is within this
+    /// fraction of the leg length of its ground; above it (a run's flight)
+    /// the root keeps its own velocity, with a linear blend in between.
+    pub height_tolerance: f32,
+    /// How sharply the lowest foot joint wins the vote: a joint this much
+    /// higher (fraction of the leg length) than the lowest weighs e^-1 as
+    /// much.
+    pub height_scale: f32,
+    /// How sharply the slowest foot joint wins: one faster than the slowest
+    /// by this many leg lengths per second weighs e^-1 as much. A swing
+    /// foot passes within a centimetre or two of the ground; its speed
+    /// tells it from the planted one.
+    pub speed_scale: f32,
+    /// Standard deviation of the gaussian that smooths the root's
+    /// frame-to-frame steps, in seconds: the votes carry the decoder's
+    /// jitter.
+    pub smoothing_seconds: f32,
+}
+
+impl Default for RootFromFeetOptions {
+    /// Chosen on real walks (the root they give a real take travels 92-98%
+    /// of its captured distance) and on the evaluation's restyled pairs (no
+    /// more jitter than with the source's path); see `bench/results/style.md`.
+    fn default() -> Self {
+        RootFromFeetOptions {
+            height_tolerance: 0.05,
+            height_scale: 0.01,
+            speed_scale: 0.1,
+            smoothing_seconds: 0.05,
+        }
+    }
+}
+
+/// Moves the root horizontally so that the foot on the ground stands still
+/// (see the module docs); joint rotations and the root's height and heading
+/// are kept. For every step from frame `f - 1` to `f`, the foot joints
+/// (ankles and toes) vote: a planted joint still in the world means the
+/// root moved by minus the joint's movement relative to the pelvis. The
+/// votes are weighted towards the lowest and slowest joint (a softmin over
+/// height above its ground and horizontal speed), which is the one a real
+/// foot pivots on: the heel after it strikes, the ball of the foot as the
+/// heel rises. With no foot near the ground the root keeps its own step.
+/// The steps are then smoothed along time. Returns the mean horizontal
+/// distance between the new and the old root, in file units.
+pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFeetOptions) -> f32 {
+    let poses = forward_kinematics(motion);
+    let n = poses.frame_count;
+    if n < 2 {
+        return 0.0;
+    }
+    let up = up_axis(&poses.positions, poses.joint_count, rig);
+    let horizontal = |p: Vec3| p - up * p.dot(up);
+    let leg = rig.leg_length(motion.skeleton()).max(1e-6);
+    let tolerance = options.height_tolerance * leg;
+    let height_scale = (options.height_scale * leg).max(1e-6);
+    let speed_scale = (options.speed_scale * leg / motion.fps() as f32).max(1e-6);
+    let feet: Vec<(usize, Vec<f32>)> = rig
+        .left_foot
+        .iter()
+        .chain(&rig.right_foot)
+        .map(|&j| (j, heights_above_ground(&poses, j, up)))
+        .collect();
+    let root = |f: usize| horizontal(poses.position(f, rig.pelvis));
+    let relative = |f: usize, j: usize| horizontal(poses.position(f, j)) - root(f);
+    let travel = |f: usize, j: usize| horizontal(poses.position(f, j) - poses.position(f - 1, j));
+    // own[f] and steps[f]: the root's horizontal step from frame f - 1 to
+    // f, as it is and as the feet say (both 0 for f = 0).
+    let own: Vec<Vec3> = (0..n)
+        .map(|f| {
+            if f == 0 {
+                Vec3::ZERO
+            } else {
+                root(f) - root(f - 1)
+            }
+        })
+        .collect();
+    let mut steps = own.clone();
+    for f in 1..n {
+        let height = |h: &[f32]| h[f].max(h[f - 1]);
+        let lowest = feet
+            .iter()
+            .map(|(_, h)| height(h))
+            .fold(f32::INFINITY, f32::min);
+        let on_ground = if tolerance > 0.0 {
+            (1.0 - lowest / tolerance).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        if on_ground <= 0.0 {
+            continue;
+        }
+        let slowest = feet
+            .iter()
+            .map(|(j, _)| travel(f, *j).length())
+            .fold(f32::INFINITY, f32::min);
+        let (mut vote, mut total) = (Vec3::ZERO, 0.0f32);
+        for (j, h) in &feet {
+            let w = (-(height(h) - lowest) / height_scale
+                - (travel(f, *j).length() - slowest) / speed_scale)
+                .exp();
+            vote -= (relative(f, *j) - relative(f - 1, *j)) * w;
+            total += w;
+        }
+        steps[f] = vote / total * on_ground + own[f] * (1.0 - on_ground);
+    }
+    let steps = smooth_steps(&steps, options.smoothing_seconds * motion.fps() as f32);
+    let parent = motion.skeleton().joint(rig.pelvis).parent;
+    let mut shift = Vec3::ZERO;
+    let mut moved = 0.0f32;
+    for f in 1..n {
+        shift += steps[f] - own[f];
+        moved += shift.length();
+        let to_local = parent.map_or(Quat::IDENTITY, |p| poses.rotation(f, p).inverse());
+        let t = motion.local_translation(f, rig.pelvis);
+        motion.set_local_translation(f, rig.pelvis, t + to_local * shift);
+    }
+    moved / n as f32
+}
+
+/// Horizontal distance the pelvis travels over the clip (file units): the
+/// length of its path on the ground, sway included.
+pub fn travelled(motion: &Motion, rig: &RigLayout) -> f32 {
+    let poses = forward_kinematics(motion);
+    let up = up_axis(&poses.positions, poses.joint_count, rig);
+    (1..poses.frame_count)
+        .map(|f| {
+            let d = poses.position(f, rig.pelvis) - poses.position(f - 1, rig.pelvis);
+            (d - up * d.dot(up)).length()
+        })
+        .sum()
+}
+
+/// Gaussian smoothing (standard deviation `sigma` frames) of the steps
+/// `1..`; the first entry (no step) stays 0, and the kernel is cut and
+/// renormalised at the ends.
+fn smooth_steps(steps: &[Vec3], sigma: f32) -> Vec<Vec3> {
+    if sigma <= 0.0 || steps.len() < 3 {
+        return steps.to_vec();
+    }
+    let reach = (3.0 * sigma).ceil() as usize;
+    let kernel: Vec<f32> = (0..=reach)
+        .map(|k| (-((k * k) as f32) / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let n = steps.len();
+    let mut out = vec![Vec3::ZERO; n];
+    for (f, o) in out.iter_mut().enumerate().skip(1) {
+        let (mut sum, mut weight) = (Vec3::ZERO, 0.0);
+        for g in f.saturating_sub(reach).max(1)..=(f + reach).min(n - 1) {
+            let w = kernel[f.abs_diff(g)];
+            sum += steps[g] * w;
+            weight += w;
+        }
+        *o = sum / weight;
+    }
+    out
 }
 
 /// Two-bone inverse kinematics: the world-space turns of the hip (about
@@ -223,6 +403,87 @@ mod tests {
             assert!((shin(&before) - shin(&after)).abs() < 1e-2);
             assert!((before.position(f, rig.head) - after.position(f, rig.head)).length() < 1e-3);
         }
+    }
+
+    /// On real takes (feet planted) the feet move the root about as the
+    /// capture did: walks forward, back, sideways, turning, and a run.
+    #[test]
+    fn the_feet_carry_a_real_take_about_as_far_as_it_went() {
+        for name in [
+            "dataset-1_walk_proud_002.bvh",
+            "dataset-1_walk_old_001.bvh",
+            "dataset-1_walk-back_normal_001.bvh",
+            "dataset-1_walk-left_normal_001.bvh",
+            "dataset-2_walk-turn-left_feminine_001.bvh",
+            "dataset-1_run_normal_001.bvh",
+        ] {
+            let Some(mut motion) = bandai_walk(name) else {
+                return;
+            };
+            let rig = RigLayout::from_skeleton(motion.skeleton()).unwrap();
+            let (distance, skating) = (travelled(&motion, &rig), foot_skating(&motion, &rig));
+            let before = forward_kinematics(&motion);
+            root_from_feet(&mut motion, &rig, &RootFromFeetOptions::default());
+            let after = forward_kinematics(&motion);
+            let ratio = travelled(&motion, &rig) / distance;
+            let end = motion.frame_count() - 1;
+            let off = (after.position(end, rig.pelvis) - before.position(end, rig.pelvis)).length();
+            assert!(
+                (0.9..1.02).contains(&ratio),
+                "{name}: distance ratio {ratio}"
+            );
+            assert!(
+                off < 0.1 * distance,
+                "{name}: ends {off} off after {distance}"
+            );
+            assert!(
+                foot_skating(&motion, &rig) < skating + 1.0,
+                "{name}: skating {skating} -> {}",
+                foot_skating(&motion, &rig)
+            );
+            // Only the root moved: the head keeps its place relative to it.
+            let head = |p: &mocap_core::GlobalPoses, f| {
+                p.position(f, rig.head) - p.position(f, rig.pelvis)
+            };
+            assert!((head(&before, end) - head(&after, end)).length() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn the_feet_undo_a_sliding_root_on_a_real_walk() {
+        let Some(real) = bandai_walk("dataset-1_walk_proud_002.bvh") else {
+            return;
+        };
+        let rig = RigLayout::from_skeleton(real.skeleton()).unwrap();
+        let mut motion = real.clone();
+        // Drag the pelvis sideways at 40 cm/s: the planted feet slide.
+        let fps = motion.fps() as f32;
+        for f in 0..motion.frame_count() {
+            let t = motion.local_translation(f, rig.pelvis);
+            motion.set_local_translation(
+                f,
+                rig.pelvis,
+                t + Vec3::new(40.0 * f as f32 / fps, 0.0, 0.0),
+            );
+        }
+        let sliding = foot_skating(&motion, &rig);
+        assert!(sliding > foot_skating(&real, &rig) + 20.0);
+        root_from_feet(&mut motion, &rig, &RootFromFeetOptions::default());
+        let fixed = foot_skating(&motion, &rig);
+        assert!(
+            fixed < foot_skating(&real, &rig) + 5.0,
+            "{sliding} -> {fixed}"
+        );
+        // The drag is gone: the path is the real one again, within a tenth
+        // of the drag at the end.
+        let end = motion.frame_count() - 1;
+        let drag = 40.0 * end as f32 / fps;
+        let path = |m: &Motion| forward_kinematics(m).position(end, rig.pelvis);
+        let off = (path(&motion) - path(&real)).length();
+        assert!(
+            off < 0.1 * drag,
+            "ends {off} from the real path after a drag of {drag}"
+        );
     }
 
     #[test]

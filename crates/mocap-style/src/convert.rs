@@ -184,6 +184,11 @@ pub struct ConvertOptions {
     /// ([`crate::contact`]); applied by [`crate::apply::restyle`].
     #[serde(default)]
     pub foot_contacts: bool,
+    /// Move the root with the feet on the ground after decoding
+    /// ([`crate::contact::root_from_feet`]) instead of along the source's
+    /// path; applied by [`crate::apply::restyle`] before `foot_contacts`.
+    #[serde(default)]
+    pub root_from_feet: bool,
 }
 
 impl Default for ConvertOptions {
@@ -196,6 +201,7 @@ impl Default for ConvertOptions {
             strength: 1.0,
             fade_in_frames: 0.0,
             foot_contacts: false,
+            root_from_feet: false,
         }
     }
 }

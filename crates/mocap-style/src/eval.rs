@@ -34,6 +34,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
+use crate::contact::{heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter};
 use crate::features::{up_axis, RigLayout};
@@ -144,6 +145,11 @@ pub struct MethodScores {
     pub jitter: f64,
     /// Mean output duration over source duration.
     pub time_scale: f64,
+    /// Mean distance the pelvis travels horizontally in the output over
+    /// the distance it travels in the source (1 when the root follows the
+    /// source's path; the feet set it with `root_from_feet`).
+    #[serde(default)]
+    pub distance_ratio: f64,
     /// Mean seconds per restyle (prepare to compose, style encoding included).
     pub seconds_per_pair: f64,
 }
@@ -162,6 +168,8 @@ pub struct PairResult {
     pub foot_skating: f64,
     pub jitter: f64,
     pub time_scale: f64,
+    #[serde(default)]
+    pub distance_ratio: f64,
     pub timings: StageTimings,
 }
 
@@ -275,12 +283,9 @@ pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
     let mut sum = 0.0f64;
     let mut count = 0usize;
     for &j in rig.left_foot.iter().chain(&rig.right_foot) {
-        let mut heights: Vec<f32> = (0..n).map(|f| poses.position(f, j).dot(up)).collect();
-        let h = heights.clone();
-        heights.sort_by(|a, b| a.total_cmp(b));
-        let ground = heights[(n - 1) * 2 / 100];
+        let h = heights_above_ground(&poses, j, up);
         for f in 1..n {
-            if h[f] <= ground + tolerance && h[f - 1] <= ground + tolerance {
+            if h[f] <= tolerance && h[f - 1] <= tolerance {
                 let d = poses.position(f, j) - poses.position(f - 1, j);
                 let horizontal = d - up * d.dot(up);
                 sum += (horizontal.length() * fps) as f64;
@@ -647,6 +652,7 @@ fn evaluate_set(
                     foot_skating: foot_skating(out, rig),
                     jitter: motion_jitter(out),
                     time_scale: out.duration() / source.motion.duration(),
+                    distance_ratio: (travelled(out, rig) / travelled(&source.motion, rig)) as f64,
                     timings: restyled.timings,
                 });
             }
@@ -663,6 +669,7 @@ fn evaluate_set(
                 foot_skating: foot_skating(&source.motion, rig),
                 jitter: motion_jitter(&source.motion),
                 time_scale: 1.0,
+                distance_ratio: 1.0,
                 timings: StageTimings::default(),
             });
         }
@@ -732,6 +739,7 @@ fn evaluate_set(
             foot_skating: mean(&|r| r.foot_skating),
             jitter: mean(&|r| r.jitter),
             time_scale: mean(&|r| r.time_scale),
+            distance_ratio: mean(&|r| r.distance_ratio),
             seconds_per_pair: mean(&|r| r.timings.total()),
         }
     };
@@ -761,6 +769,7 @@ fn evaluate_set(
                 foot_skating: foot_skating(&c.motion, rig),
                 jitter: motion_jitter(&c.motion),
                 time_scale: 1.0,
+                distance_ratio: 1.0,
                 timings: StageTimings::default(),
             })
         })
@@ -880,14 +889,14 @@ impl EvalReport {
             s.push_str(
                 "| method | pairs | style acc. | style acc. where the classifier knows the style clip | content acc. | \\|T_out - T_style\\| (s) | \
                  \\|T_out - T_source\\| (s) | closer to style | foot skating (units/s) | jitter \
-                 (units/frame³) | duration ratio | s per restyle |\n",
+                 (units/frame³) | duration ratio | distance ratio | s per restyle |\n",
             );
             s.push_str(
-                "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+                "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
             );
             for m in set.reference.iter().chain(&set.methods) {
                 s.push_str(&format!(
-                    "| {} | {} | {:.1}% | {:.1}% ({} pairs) | {:.1}% | {:.3} | {:.3} | {:.0}% ({} timed) | {:.2} | {:.4} | {:.2} | {:.3} |\n",
+                    "| {} | {} | {:.1}% | {:.1}% ({} pairs) | {:.1}% | {:.3} | {:.3} | {:.0}% ({} timed) | {:.2} | {:.4} | {:.2} | {:.2} | {:.3} |\n",
                     m.method,
                     m.pairs,
                     100.0 * m.style_accuracy,
@@ -901,6 +910,7 @@ impl EvalReport {
                     m.foot_skating,
                     m.jitter,
                     m.time_scale,
+                    m.distance_ratio,
                     m.seconds_per_pair,
                 ));
             }

@@ -103,6 +103,14 @@ struct ApplyArgs {
     /// Patch length in frames.
     #[arg(long)]
     patch: Option<usize>,
+    /// Let the planted feet carry the body instead of the source's path: no foot sliding, but the
+    /// distance covered follows the strides (reported as the distance ratio).
+    #[arg(long)]
+    root_from_feet: bool,
+    /// Pin the ankles on the ground by turning hips and knees (keeps the source's path; costs
+    /// some style, see bench/results/style.md).
+    #[arg(long)]
+    foot_contacts: bool,
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
     #[arg(long)]
@@ -132,6 +140,12 @@ struct EvalArgs {
     /// Patch length in frames.
     #[arg(long)]
     patch: Option<usize>,
+    /// Restyle with the root carried by the planted feet (as `apply --root-from-feet`).
+    #[arg(long)]
+    root_from_feet: bool,
+    /// Restyle with the ankles pinned on the ground (as `apply --foot-contacts`).
+    #[arg(long)]
+    foot_contacts: bool,
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
     trees: usize,
@@ -217,17 +231,20 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if let Some(patch) = a.patch {
                 apply_options.patch = patch;
             }
+            apply_options.root_from_feet = a.root_from_feet;
+            apply_options.foot_contacts = a.foot_contacts;
             apply_options.device = a.device;
             let report = apply(&apply_options)?;
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else if !options.quiet {
                 eprintln!(
-                    "wrote {} ({} frames from {}; time scale {:.2})",
+                    "wrote {} ({} frames from {}; time scale {:.2}, distance ratio {:.2})",
                     report.out.display(),
                     report.output_frames,
                     report.source_frames,
-                    report.time_scale
+                    report.time_scale,
+                    report.distance_ratio
                 );
             }
         }
@@ -251,6 +268,8 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if let Some(patch) = a.patch {
                 eval_options.convert.patch = patch;
             }
+            eval_options.convert.root_from_feet = a.root_from_feet;
+            eval_options.convert.foot_contacts = a.foot_contacts;
             let report = evaluate(&eval_options)?;
             let markdown = report.to_markdown();
             if let Some(path) = &a.markdown {
