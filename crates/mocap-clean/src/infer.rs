@@ -20,7 +20,9 @@ use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{header_from_bytes, load_weights_from_bytes};
+use mocap_nn::checkpoint::{
+    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
+};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -75,7 +77,7 @@ impl CleanModel {
 
     /// The shipped default model, or the file named by the
     /// `MOCAP_CLEAN_MODEL` environment variable. The default model
-    /// (`models/clean-default.safetensors`, about 6.6 MB with the Wiener filter it corrects) is compiled into the
+    /// (`models/clean-default.safetensors`, about 20 MB with the Wiener mixture it corrects) is compiled into the
     /// binary, so it works wherever the binary is installed.
     pub fn load_default(device: DeviceChoice) -> Result<CleanModel> {
         if let Some(path) = std::env::var_os("MOCAP_CLEAN_MODEL") {
@@ -332,6 +334,61 @@ impl CleanModel {
     /// ([`ModelDescription::base_wiener`]).
     pub fn base_wiener(&self) -> Option<&WienerFilter> {
         self.base_wiener.as_ref()
+    }
+
+    /// The same network correcting another Wiener filter: one with the same
+    /// rig, segment and noise covariance as its own (e.g. a mixture made from
+    /// it by [`crate::wiener::fit_mixture`]), so the noise level it reads
+    /// means the same. The network is not retrained.
+    pub fn with_base_wiener(mut self, wiener: WienerFilter) -> Result<CleanModel> {
+        let own = self.base_wiener.as_ref().ok_or_else(|| {
+            CleanError::Invalid("this model corrects no Wiener filter to replace".into())
+        })?;
+        let (a, b) = (&own.description, &wiener.description);
+        if a.joints != b.joints
+            || a.segment != b.segment
+            || a.noise_sigma_deg != b.noise_sigma_deg
+            || own.noise_covariance() != wiener.noise_covariance()
+        {
+            return Err(CleanError::Invalid(
+                "the new Wiener filter differs from the model's in rig, segment or noise \
+                 covariance"
+                    .into(),
+            ));
+        }
+        self.description.base_wiener = Some(b.clone());
+        self.base_wiener = Some(wiener);
+        Ok(self)
+    }
+
+    /// Writes the model (the network and the Wiener filter it corrects) to
+    /// `path`, atomically, with `data` and `training` in its header (e.g.
+    /// those of the file it was loaded from, [`CleanModel::header_of`]).
+    pub fn save(
+        &self,
+        path: &Path,
+        data: serde_json::Value,
+        training: serde_json::Value,
+    ) -> Result<()> {
+        let mut module = self.model.clone();
+        module.base = self.base_wiener.as_ref().map(WienerFilter::to_tensors);
+        let header = CheckpointHeader {
+            kind: CHECKPOINT_KIND.into(),
+            kind_version: CHECKPOINT_KIND_VERSION,
+            config: serde_json::to_value(&self.description)
+                .map_err(|e| CleanError::Invalid(format!("describing the model: {e}")))?,
+            data,
+            training,
+        };
+        save_weights(path, &module, &header)?;
+        Ok(())
+    }
+
+    /// The `data` and `training` records of a model file's header.
+    pub fn header_of(path: &Path) -> Result<(serde_json::Value, serde_json::Value)> {
+        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+        let header = header_from_bytes(&bytes, path)?;
+        Ok((header.data, header.training))
     }
 
     /// Zeroes the network's output layer, so that the model gives its base

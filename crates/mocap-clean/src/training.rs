@@ -1341,6 +1341,76 @@ mod tests {
     }
 
     #[test]
+    fn a_network_is_rebased_on_a_mixture_of_its_own_filter() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let (options, wiener_path) = tiny_setup_on_wiener(dir.path(), "to-rebase.safetensors");
+        let report = train(&options).unwrap();
+        let rebased_path = dir.path().join("rebased.safetensors");
+        let fit = crate::wiener::WienerFitOptions {
+            inputs: options.inputs.clone(),
+            out: rebased_path.clone(),
+            split: options.split,
+            mixture_min_segments: Some(1),
+            rebase: Some(report.model.clone()),
+            ..Default::default()
+        };
+        let fitted = crate::wiener::fit_files(&fit).unwrap();
+        // The synthetic take names carry no content: the rest and all.
+        let names: Vec<&str> = fitted
+            .description
+            .components
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect();
+        assert_eq!(names, ["other", "all"]);
+        let original = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let rebased = crate::infer::CleanModel::load(&rebased_path, Default::default()).unwrap();
+        assert_eq!(rebased.description.network, original.description.network);
+        assert_eq!(model_base(&rebased).description.component_count(), 2);
+        // The same network on a filter whose components both come from the
+        // same takes: nearly the same output.
+        let clean = synthetic_motion_phase(90, 4, 0.2);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let noisy = crate::noise::add_random_noise_sigma(
+            &clean,
+            4.0,
+            &crate::noise::RandomNoise::default(),
+            &mut rng,
+        );
+        let off = crate::eval::rotation_error_deg(
+            &original.clean(&noisy, None).unwrap(),
+            &rebased.clean(&noisy, None).unwrap(),
+        );
+        assert!(off < 0.5, "{off} degrees apart");
+        // The header keeps the network's training record and says what was done.
+        let (data, training) = crate::infer::CleanModel::header_of(&rebased_path).unwrap();
+        assert!(data["rebased"]["mixture_min_segments"] == 1, "{data}");
+        assert!(!training.is_null());
+        // A filter with another noise covariance is refused, and so is a
+        // rebase without a mixture or of a file that is no network.
+        let takes = load_takes(&list_bvh(&options.inputs).unwrap()).unwrap();
+        let refs: Vec<&Motion> = takes.iter().map(|t| &t.motion).collect();
+        let other =
+            WienerFilter::fit(&refs, &crate::noise::RandomNoise::default(), 3.0, 32, 9).unwrap();
+        assert!(original.with_base_wiener(other).is_err());
+        let error = crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+            mixture_min_segments: None,
+            ..fit.clone()
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains("needs a mixture"), "{error}");
+        let error = crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+            rebase: Some(wiener_path),
+            ..fit
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains(crate::wiener::WIENER_KIND), "{error}");
+    }
+
+    #[test]
     fn a_model_reading_its_base_gets_the_filter_output_and_the_noise_level() {
         let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();

@@ -50,6 +50,19 @@
 //! not foresee would be taken for noise). A clean take gets a `sigma` near 0
 //! and is nearly left alone.
 //!
+//! ## Mixture
+//!
+//! One `S(f)` for every kind of motion is a compromise: a slow gesture has
+//! less power at high frequencies than a run. A filter may hold several
+//! sets of spectra (components, e.g. one per content of the training data,
+//! all with the same `N`); for each take the component and the level of
+//! largest marginal likelihood (2) are chosen together, which compares
+//! across components since they share `N` and so the whitening. This is a
+//! hard choice per take, not a blend. The choice reads at most 8 segments
+//! spread over the take, so that its cost does not grow with the take's
+//! length times the number of components; the level is then estimated on
+//! every segment with the chosen component.
+//!
 //! ## Limits
 //!
 //! It is linear: spikes (another motion pasted on a subtree) are smeared,
@@ -75,7 +88,7 @@ use rustfft::{Fft, FftPlanner};
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{
-    list_bvh, load_takes, paths_in_split, DataDescription, Split, SplitFractions,
+    list_bvh, load_takes, paths_in_split, DataDescription, Split, SplitFractions, Take,
 };
 use crate::features::{FeatureLayout, Representation};
 use crate::noise::{add_random_noise_sigma, RandomNoise};
@@ -87,6 +100,10 @@ type C64 = Complex<f64>;
 pub const WIENER_KIND: &str = "mocap-clean/wiener";
 /// Version of [`WienerDescription`]'s layout.
 pub const WIENER_KIND_VERSION: u32 = 1;
+
+/// A mixture's component is chosen on at most this many segments of a take
+/// (about 140 frames' worth; see "Mixture" in the module docs).
+const CHOICE_SEGMENTS: usize = 8;
 
 /// The noise levels (degrees) the marginal likelihood (2) is evaluated at.
 fn sigma_grid_deg() -> impl Iterator<Item = f64> {
@@ -112,6 +129,30 @@ pub struct WienerDescription {
     pub segments: usize,
     /// Takes left out because their rig differs from the first take's.
     pub other_rig_takes: usize,
+    /// The components of a mixture, in the order their spectra are stored
+    /// (see "Mixture" in the module docs); empty for one set of spectra.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub components: Vec<ComponentInfo>,
+    /// The spectra are stored as the upper triangles of their real and
+    /// imaginary parts (they are Hermitian), half the size; files written
+    /// before this have every entry.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub packed_spectra: bool,
+}
+
+/// One component of a mixture: the kind of motion its spectra come from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComponentInfo {
+    pub name: String,
+    pub takes: usize,
+    pub segments: usize,
+}
+
+impl WienerDescription {
+    /// Sets of spectra stored (1 unless a mixture).
+    pub fn component_count(&self) -> usize {
+        self.components.len().max(1)
+    }
 }
 
 /// The stored numbers: per frequency bin the real and imaginary parts of
@@ -140,13 +181,21 @@ struct Bin {
     noisy_lambda: Vec<f64>,
 }
 
+/// The spectra of one kind of motion and the bases of (1) built from them.
+#[derive(Debug, Clone)]
+struct Component {
+    spectra: Vec<DMatrix<C64>>,
+    bins: Vec<Bin>,
+}
+
 /// A fitted filter (see the module docs).
 #[derive(Debug, Clone)]
 pub struct WienerFilter {
     pub description: WienerDescription,
-    spectra: Vec<DMatrix<C64>>,
+    /// One set of spectra, or one per kind of motion (a mixture), all with
+    /// the same `N`.
+    components: Vec<Component>,
     noise: DMatrix<f64>,
-    bins: Vec<Bin>,
 }
 
 /// What filtering a take did.
@@ -154,6 +203,9 @@ pub struct WienerFilter {
 pub struct WienerOutcome {
     /// The noise level used (estimated unless given), degrees.
     pub sigma_deg: f64,
+    /// The component of a mixture used (0 for a single filter).
+    #[serde(default)]
+    pub component: usize,
 }
 
 /// A joint's 6 features have 3 degrees of freedom, so `N` is singular: a
@@ -271,6 +323,77 @@ impl Transforms {
     }
 }
 
+/// The shapes of one bin's real and imaginary parts in a file: whole
+/// `c x c` matrices, or (packed) the upper triangle with the diagonal and
+/// the one without it, as `1 x n` rows.
+fn spectrum_layout(description: &WienerDescription) -> ((usize, usize), (usize, usize)) {
+    let c = description.channels;
+    if description.packed_spectra {
+        ((1, c * (c + 1) / 2), (1, c * (c - 1) / 2))
+    } else {
+        ((c, c), (c, c))
+    }
+}
+
+/// Welch's estimate of the clean cross-spectra `S(f)` of the features of
+/// `takes` (all on `layout`'s rig): the mean of `X X^H` over
+/// half-overlapping Hann segments. Returns the spectra and the number of
+/// segments.
+fn welch_spectra(
+    takes: &[&Motion],
+    layout: &FeatureLayout,
+    segment: usize,
+) -> Result<(Vec<DMatrix<C64>>, usize)> {
+    let c = layout.channels();
+    let bins = segment / 2 + 1;
+    let window: Vec<f64> = (0..segment).map(|t| hann(t, segment)).collect();
+    let window_power: f64 = window.iter().map(|w| w * w).sum();
+    let transforms = Transforms::new(segment);
+    // Welch: the mean of X X^H over half-overlapping Hann segments.
+    let per_take: Vec<(Vec<DMatrix<C64>>, usize)> = takes
+        .par_iter()
+        .map(|m| {
+            let (x, _) = centred(&layout.encode(m), c);
+            let frames = x.len() / c;
+            let mut sums = vec![DMatrix::<C64>::zeros(c, c); bins];
+            let mut count = 0;
+            let mut start = 0;
+            while start + segment <= frames {
+                let spectrum = transforms.segment_spectrum(&x, c, start, &window);
+                for (b, sum) in sums.iter_mut().enumerate() {
+                    let column = spectrum.column(b);
+                    sum.ger(
+                        C64::new(1.0, 0.0),
+                        &column,
+                        &column.map(|v| v.conj()),
+                        C64::new(1.0, 0.0),
+                    );
+                }
+                count += 1;
+                start += segment / 2;
+            }
+            (sums, count)
+        })
+        .collect();
+    let segments: usize = per_take.iter().map(|(_, n)| n).sum();
+    if segments == 0 {
+        return Err(CleanError::Invalid(format!(
+            "no take is {segment} frames long: nothing to estimate the spectra from"
+        )));
+    }
+    let mut spectra = vec![DMatrix::<C64>::zeros(c, c); bins];
+    for (sums, _) in per_take {
+        for (total, sum) in spectra.iter_mut().zip(sums) {
+            *total += sum;
+        }
+    }
+    let scale = C64::new(1.0 / (segments as f64 * window_power), 0.0);
+    for s in &mut spectra {
+        *s *= scale;
+    }
+    Ok((spectra, segments))
+}
+
 impl WienerFilter {
     /// Fits the filter to clean takes (all on the rig of the first; others
     /// are counted and left out): the signal spectra from every take, the
@@ -302,52 +425,7 @@ impl WienerFilter {
             })
             .collect();
         let c = layout.channels();
-        let bins = segment / 2 + 1;
-        let window: Vec<f64> = (0..segment).map(|t| hann(t, segment)).collect();
-        let window_power: f64 = window.iter().map(|w| w * w).sum();
-        let transforms = Transforms::new(segment);
-        // Welch: the mean of X X^H over half-overlapping Hann segments.
-        let per_take: Vec<(Vec<DMatrix<C64>>, usize)> = same_rig
-            .par_iter()
-            .map(|m| {
-                let (x, _) = centred(&layout.encode(m), c);
-                let frames = x.len() / c;
-                let mut sums = vec![DMatrix::<C64>::zeros(c, c); bins];
-                let mut count = 0;
-                let mut start = 0;
-                while start + segment <= frames {
-                    let spectrum = transforms.segment_spectrum(&x, c, start, &window);
-                    for (b, sum) in sums.iter_mut().enumerate() {
-                        let column = spectrum.column(b);
-                        sum.ger(
-                            C64::new(1.0, 0.0),
-                            &column,
-                            &column.map(|v| v.conj()),
-                            C64::new(1.0, 0.0),
-                        );
-                    }
-                    count += 1;
-                    start += segment / 2;
-                }
-                (sums, count)
-            })
-            .collect();
-        let segments: usize = per_take.iter().map(|(_, n)| n).sum();
-        if segments == 0 {
-            return Err(CleanError::Invalid(format!(
-                "no take is {segment} frames long: nothing to estimate the spectra from"
-            )));
-        }
-        let mut spectra = vec![DMatrix::<C64>::zeros(c, c); bins];
-        for (sums, _) in per_take {
-            for (total, sum) in spectra.iter_mut().zip(sums) {
-                *total += sum;
-            }
-        }
-        let scale = C64::new(1.0 / (segments as f64 * window_power), 0.0);
-        for s in &mut spectra {
-            *s *= scale;
-        }
+        let (spectra, segments) = welch_spectra(&same_rig, &layout, segment)?;
         // N: the per-frame covariance of the noise of the features.
         let noised: Vec<(DMatrix<f64>, usize)> = same_rig
             .par_iter()
@@ -382,14 +460,94 @@ impl WienerFilter {
             frames: same_rig.iter().map(|m| m.frame_count()).sum(),
             segments,
             other_rig_takes: takes.len() - same_rig.len(),
+            components: Vec::new(),
+            packed_spectra: true,
         };
-        Ok(Self::from_parts(description, spectra, noise_cov))
+        Ok(Self::from_parts(description, vec![spectra], noise_cov))
     }
 
-    /// Builds the per-bin bases of (1) from the spectra and `N`.
+    /// The same filter with the clean spectra re-estimated from `takes`
+    /// (which must be of the filter's rig) and the same noise covariance
+    /// `N`, so that the marginal likelihoods (2) of two such filters on one
+    /// take compare.
+    pub fn with_spectra_of(&self, takes: &[&Motion]) -> Result<WienerFilter> {
+        let first = takes
+            .first()
+            .ok_or_else(|| CleanError::Invalid("no takes to estimate spectra from".into()))?;
+        let layout = self.layout_for(first)?;
+        for m in takes {
+            self.layout_for(m)?;
+        }
+        let (spectra, segments) = welch_spectra(takes, &layout, self.description.segment)?;
+        let description = WienerDescription {
+            takes: takes.len(),
+            frames: takes.iter().map(|m| m.frame_count()).sum(),
+            segments,
+            other_rig_takes: 0,
+            components: Vec::new(),
+            packed_spectra: true,
+            ..self.description.clone()
+        };
+        Ok(Self::from_parts(
+            description,
+            vec![spectra],
+            self.noise.clone(),
+        ))
+    }
+
+    /// A mixture of named single filters made by
+    /// [`WienerFilter::with_spectra_of`] from one filter (the same rig,
+    /// segment and `N`); see "Mixture" in the module docs.
+    pub fn mixture(parts: Vec<(String, WienerFilter)>) -> Result<WienerFilter> {
+        let first = match parts.first() {
+            Some((_, f)) => f,
+            None => return Err(CleanError::Invalid("a mixture needs components".into())),
+        };
+        let mut description = WienerDescription {
+            takes: 0,
+            frames: 0,
+            segments: 0,
+            components: Vec::new(),
+            packed_spectra: true,
+            ..first.description.clone()
+        };
+        let noise = first.noise.clone();
+        let mut components = Vec::new();
+        for (name, filter) in parts {
+            let d = &filter.description;
+            if filter.components.len() != 1
+                || filter.noise != noise
+                || d.joints != description.joints
+                || d.segment != description.segment
+            {
+                return Err(CleanError::Invalid(format!(
+                    "the mixture's component {name} is not a single filter with the same rig, \
+                     segment and noise covariance as the first"
+                )));
+            }
+            // The components may share takes (an "all" component): the
+            // mixture was fitted to as many as its largest one.
+            description.takes = description.takes.max(d.takes);
+            description.frames = description.frames.max(d.frames);
+            description.segments = description.segments.max(d.segments);
+            description.components.push(ComponentInfo {
+                name,
+                takes: d.takes,
+                segments: d.segments,
+            });
+            components.extend(filter.components);
+        }
+        Ok(WienerFilter {
+            description,
+            components,
+            noise,
+        })
+    }
+
+    /// Builds the per-bin bases of (1) from each component's spectra and `N`.
     fn from_parts(
         description: WienerDescription,
-        spectra: Vec<DMatrix<C64>>,
+        spectra_sets: Vec<Vec<DMatrix<C64>>>,
         noise: DMatrix<f64>,
     ) -> WienerFilter {
         let c = noise.nrows();
@@ -423,29 +581,32 @@ impl WienerFilter {
             // Hermitian up to rounding; symmetrise before the solver.
             SymmetricEigen::new((&m + m.adjoint()) * C64::new(0.5, 0.0))
         };
-        let bins = spectra
-            .par_iter()
-            .map(|s| {
-                let eigen = hermitian_eigen(&inverse_half * s * &inverse_half);
-                let noisy_white = hermitian_eigen(&noisy_whitening * s * noisy_whitening.adjoint());
-                Bin {
-                    to_white: eigen.eigenvectors.adjoint() * &inverse_half,
-                    from_white: &half * &eigen.eigenvectors,
-                    lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
-                    noisy_to_white: noisy_white.eigenvectors.adjoint() * &noisy_whitening,
-                    noisy_lambda: noisy_white
-                        .eigenvalues
-                        .iter()
-                        .map(|&l| l.max(0.0))
-                        .collect(),
-                }
-            })
-            .collect();
+        let component = |spectra: Vec<DMatrix<C64>>| -> Component {
+            let bins = spectra
+                .par_iter()
+                .map(|s| {
+                    let eigen = hermitian_eigen(&inverse_half * s * &inverse_half);
+                    let noisy_white =
+                        hermitian_eigen(&noisy_whitening * s * noisy_whitening.adjoint());
+                    Bin {
+                        to_white: eigen.eigenvectors.adjoint() * &inverse_half,
+                        from_white: &half * &eigen.eigenvectors,
+                        lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                        noisy_to_white: noisy_white.eigenvectors.adjoint() * &noisy_whitening,
+                        noisy_lambda: noisy_white
+                            .eigenvalues
+                            .iter()
+                            .map(|&l| l.max(0.0))
+                            .collect(),
+                    }
+                })
+                .collect();
+            Component { spectra, bins }
+        };
         WienerFilter {
             description,
-            spectra,
+            components: spectra_sets.into_iter().map(component).collect(),
             noise,
-            bins,
         }
     }
 
@@ -477,7 +638,13 @@ impl WienerFilter {
     ) -> Result<(Motion, WienerOutcome)> {
         let layout = self.layout_for(motion)?;
         if motion.frame_count() == 0 {
-            return Ok((motion.clone(), WienerOutcome { sigma_deg: 0.0 }));
+            return Ok((
+                motion.clone(),
+                WienerOutcome {
+                    sigma_deg: 0.0,
+                    component: 0,
+                },
+            ));
         }
         let mut features = layout.encode(motion);
         let outcome = self.filter_features(&mut features, sigma_deg);
@@ -519,6 +686,7 @@ impl WienerFilter {
         if frames == 0 {
             return WienerOutcome {
                 sigma_deg: sigma_deg.unwrap_or(0.0),
+                component: 0,
             };
         }
         let (x, mean) = centred(features, c);
@@ -534,28 +702,52 @@ impl WienerFilter {
             .par_iter()
             .map(|&s| transforms.segment_spectrum(&padded, c, s, &window))
             .collect();
-        let sigma = sigma_deg.unwrap_or_else(|| {
-            // Judged on the segments inside the take: the mirrored padding
-            // bends every channel at the take's ends, power the clean
-            // spectra never had (all segments when the take is shorter
-            // than one).
-            let inside: Vec<&DMatrix<C64>> = starts
-                .iter()
-                .zip(&spectra)
-                .filter(|(&s, _)| s >= len && s + len <= len + frames)
-                .map(|(_, spectrum)| spectrum)
-                .collect();
-            if inside.is_empty() {
-                self.estimate_sigma_deg(&spectra.iter().collect::<Vec<_>>(), &window)
-            } else {
-                self.estimate_sigma_deg(&inside, &window)
+        let (k, sigma) = match sigma_deg {
+            Some(sigma) if self.components.len() == 1 => (0, sigma),
+            _ => {
+                // Judged on the segments inside the take: the mirrored
+                // padding bends every channel at the take's ends, power the
+                // clean spectra never had (all segments when the take is
+                // shorter than one).
+                let mut inside: Vec<&DMatrix<C64>> = starts
+                    .iter()
+                    .zip(&spectra)
+                    .filter(|(&s, _)| s >= len && s + len <= len + frames)
+                    .map(|(_, spectrum)| spectrum)
+                    .collect();
+                if inside.is_empty() {
+                    inside = spectra.iter().collect();
+                }
+                // The component of largest likelihood (each at its own best
+                // level), judged on at most `CHOICE_SEGMENTS` segments spread
+                // over the take, a cost that does not grow with the take
+                // times the components; then its level on every segment.
+                let k = if self.components.len() == 1 {
+                    0
+                } else {
+                    let step = inside.len().div_ceil(CHOICE_SEGMENTS);
+                    let some: Vec<&DMatrix<C64>> =
+                        inside.iter().step_by(step.max(1)).copied().collect();
+                    self.components
+                        .iter()
+                        .map(|component| self.estimate_level(component, &some, &window).1)
+                        .enumerate()
+                        .max_by(|a, b| a.1.total_cmp(&b.1))
+                        .map_or(0, |(k, _)| k)
+                };
+                let estimated = match sigma_deg {
+                    Some(sigma) => sigma,
+                    None => self.estimate_level(&self.components[k], &inside, &window).0,
+                };
+                (k, estimated)
             }
-        });
+        };
+        let component = &self.components[k];
         let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
         let padded_missing = missing.map(|m| reflect_pad(&m[..frames * c], c, len));
         // For (3): S(f) + s N per bin, the same for every segment.
         let totals: Vec<DMatrix<C64>> = if padded_missing.is_some() {
-            self.signal_plus_noise(s)
+            self.signal_plus_noise(component, s)
         } else {
             Vec::new()
         };
@@ -571,10 +763,11 @@ impl WienerFilter {
                         .collect()
                 });
                 if !gone.is_empty() {
-                    return transforms.inverse_segment(&self.conditional_mean(x, &totals, &gone));
+                    return transforms
+                        .inverse_segment(&self.conditional_mean(component, x, &totals, &gone));
                 }
-                let mut spectrum = DMatrix::<C64>::zeros(c, self.bins.len());
-                for (b, bin) in self.bins.iter().enumerate() {
+                let mut spectrum = DMatrix::<C64>::zeros(c, component.bins.len());
+                for (b, bin) in component.bins.iter().enumerate() {
                     let z = &bin.to_white * x.column(b);
                     let gained = DVector::from_iterator(
                         c,
@@ -600,15 +793,19 @@ impl WienerFilter {
         for (i, f) in features.iter_mut().enumerate().take(frames * c) {
             *f = (sum[len * c + i] + mean[i % c]) as f32;
         }
-        WienerOutcome { sigma_deg: sigma }
+        WienerOutcome {
+            sigma_deg: sigma,
+            component: k,
+        }
     }
 
     /// `S(f) + s (N + ridge)` for every bin: the covariance of a noisy
     /// segment's bins at noise level `s`.
-    fn signal_plus_noise(&self, s: f64) -> Vec<DMatrix<C64>> {
+    fn signal_plus_noise(&self, component: &Component, s: f64) -> Vec<DMatrix<C64>> {
         let c = self.description.channels;
         let ridge = noise_ridge(&self.noise);
-        self.spectra
+        component
+            .spectra
             .iter()
             .map(|spectrum| {
                 let mut total = spectrum.clone();
@@ -628,14 +825,15 @@ impl WienerFilter {
     /// `gone` not read.
     fn conditional_mean(
         &self,
+        component: &Component,
         x: &DMatrix<C64>,
         totals: &[DMatrix<C64>],
         gone: &[usize],
     ) -> DMatrix<C64> {
         let c = self.description.channels;
         let ridge = noise_ridge(&self.noise);
-        let mut out = DMatrix::<C64>::zeros(c, self.bins.len());
-        for (b, (spectrum, total)) in self.spectra.iter().zip(totals).enumerate() {
+        let mut out = DMatrix::<C64>::zeros(c, component.bins.len());
+        for (b, (spectrum, total)) in component.spectra.iter().zip(totals).enumerate() {
             // Far above any channel's power: the channel's value is noise.
             let unknown = 1e6 * (spectrum.trace().re / c as f64 + ridge);
             let mut total = total.clone();
@@ -652,15 +850,22 @@ impl WienerFilter {
     }
 
     /// The noise level of largest marginal likelihood (2), from the
-    /// spectra of segments taken through `Bin::noisy_to_white`.
-    fn estimate_sigma_deg(&self, spectra: &[&DMatrix<C64>], window: &[f64]) -> f64 {
+    /// spectra of segments taken through `Bin::noisy_to_white`, and that
+    /// log-likelihood.
+    fn estimate_level(
+        &self,
+        component: &Component,
+        spectra: &[&DMatrix<C64>],
+        window: &[f64],
+    ) -> (f64, f64) {
         // Coefficients of a window v have variance (lambda + s) sum(v^2)
         // in the units the spectra were normalised to.
         let norm: f64 = window.iter().map(|v| v * v).sum();
         let len = self.description.segment;
         // Power per bin and coordinate, summed over segments.
         let empty = || -> Vec<Vec<f64>> {
-            self.bins
+            component
+                .bins
                 .iter()
                 .map(|bin| vec![0.0; bin.noisy_lambda.len()])
                 .collect()
@@ -668,7 +873,7 @@ impl WienerFilter {
         let power = spectra
             .par_iter()
             .fold(empty, |mut power, x| {
-                for (b, (p, bin)) in power.iter_mut().zip(&self.bins).enumerate() {
+                for (b, (p, bin)) in power.iter_mut().zip(&component.bins).enumerate() {
                     let z = &bin.noisy_to_white * x.column(b);
                     for (pi, v) in p.iter_mut().zip(z.iter()) {
                         *pi += v.norm_sqr() / norm;
@@ -687,7 +892,7 @@ impl WienerFilter {
         let n = spectra.len() as f64;
         let log_likelihood = |s: f64| -> f64 {
             let mut total = 0.0;
-            for (b, (bin, p)) in self.bins.iter().zip(&power).enumerate() {
+            for (b, (bin, p)) in component.bins.iter().zip(&power).enumerate() {
                 let weight = if b == 0 || 2 * b == len { 0.5 } else { 1.0 };
                 let mut sum = 0.0;
                 for (&l, &pi) in bin.noisy_lambda.iter().zip(p) {
@@ -702,7 +907,7 @@ impl WienerFilter {
         sigma_grid_deg()
             .map(|sigma| (sigma, log_likelihood((sigma / reference).powi(2))))
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(0.0, |(sigma, _)| sigma)
+            .unwrap_or((0.0, 0.0))
     }
 
     /// The stored numbers as a burn module (for a file of their own, or
@@ -710,28 +915,37 @@ impl WienerFilter {
     pub(crate) fn to_tensors(&self) -> WienerTensors {
         let device = Device::flex();
         let c = self.description.channels;
-        let bins = self.spectra.len();
-        // Row-major, as `from_tensors` reads them.
-        let part = |f: fn(&C64) -> f64| -> Vec<f32> {
-            self.spectra
-                .iter()
-                .flat_map(|s| {
-                    s.transpose()
-                        .iter()
-                        .map(f)
-                        .map(|v| v as f32)
-                        .collect::<Vec<_>>()
-                })
-                .collect()
-        };
+        let (re_len, im_len) = spectrum_layout(&self.description);
+        // Every component's bins one after the other, as `from_tensors`
+        // reads them: whole matrices row-major, or their upper triangles.
+        let spectra: Vec<&DMatrix<C64>> = self.components.iter().flat_map(|k| &k.spectra).collect();
+        let packed = self.description.packed_spectra;
+        let (mut re, mut im) = (Vec::new(), Vec::new());
+        for s in &spectra {
+            for i in 0..c {
+                for j in 0..c {
+                    let v = s[(i, j)];
+                    if !packed {
+                        re.push(v.re as f32);
+                        im.push(v.im as f32);
+                    } else if j >= i {
+                        re.push(v.re as f32);
+                        if j > i {
+                            im.push(v.im as f32);
+                        }
+                    }
+                }
+            }
+        }
+        let n = spectra.len();
         let noise: Vec<f32> = self.noise.transpose().iter().map(|&v| v as f32).collect();
         WienerTensors {
             spectra_re: Param::from_tensor(Tensor::from_data(
-                TensorData::new(part(|v| v.re), [bins, c, c]),
+                TensorData::new(re, [n, re_len.0, re_len.1]),
                 &device,
             )),
             spectra_im: Param::from_tensor(Tensor::from_data(
-                TensorData::new(part(|v| v.im), [bins, c, c]),
+                TensorData::new(im, [n, im_len.0, im_len.1]),
                 &device,
             )),
             noise: Param::from_tensor(Tensor::from_data(TensorData::new(noise, [c, c]), &device)),
@@ -761,10 +975,12 @@ impl WienerFilter {
     /// Zeros of the shapes `description` stores, to load a file into.
     pub(crate) fn empty_tensors(description: &WienerDescription) -> WienerTensors {
         let device = Device::flex();
-        let (c, bins) = (description.channels, description.segment / 2 + 1);
+        let c = description.channels;
+        let bins = description.component_count() * (description.segment / 2 + 1);
+        let (re, im) = spectrum_layout(description);
         WienerTensors {
-            spectra_re: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
-            spectra_im: Param::from_tensor(Tensor::zeros([bins, c, c], &device)),
+            spectra_re: Param::from_tensor(Tensor::zeros([bins, re.0, re.1], &device)),
+            spectra_im: Param::from_tensor(Tensor::zeros([bins, im.0, im.1], &device)),
             noise: Param::from_tensor(Tensor::zeros([c, c], &device)),
         }
     }
@@ -785,16 +1001,45 @@ impl WienerFilter {
         if re.iter().chain(&im).chain(&noise).any(|v| !v.is_finite()) {
             return Err("the Wiener filter holds non-finite numbers".into());
         }
-        let spectra = (0..bins)
-            .map(|b| {
-                DMatrix::from_fn(c, c, |i, j| {
-                    let k = (b * c + i) * c + j;
-                    C64::new(re[k] as f64, im[k] as f64)
-                })
+        let (re_len, im_len) = spectrum_layout(&description);
+        let (re_len, im_len) = (re_len.0 * re_len.1, im_len.0 * im_len.1);
+        let packed = description.packed_spectra;
+        let matrix = |b: usize| -> DMatrix<C64> {
+            let (re, im) = (
+                &re[b * re_len..(b + 1) * re_len],
+                &im[b * im_len..(b + 1) * im_len],
+            );
+            if !packed {
+                return DMatrix::from_fn(c, c, |i, j| {
+                    C64::new(re[i * c + j] as f64, im[i * c + j] as f64)
+                });
+            }
+            let mut m = DMatrix::<C64>::zeros(c, c);
+            let (mut r, mut q) = (0, 0);
+            for i in 0..c {
+                for j in i..c {
+                    let imag = if j > i {
+                        q += 1;
+                        im[q - 1] as f64
+                    } else {
+                        0.0
+                    };
+                    m[(i, j)] = C64::new(re[r] as f64, imag);
+                    m[(j, i)] = m[(i, j)].conj();
+                    r += 1;
+                }
+            }
+            m
+        };
+        let spectra_sets = (0..description.component_count())
+            .map(|component| {
+                (component * bins..(component + 1) * bins)
+                    .map(matrix)
+                    .collect()
             })
             .collect();
         let noise = DMatrix::from_fn(c, c, |i, j| noise[i * c + j] as f64);
-        Ok(Self::from_parts(description, spectra, noise))
+        Ok(Self::from_parts(description, spectra_sets, noise))
     }
 
     /// Writes the filter (atomically) in the checkpoint format the networks use.
@@ -838,7 +1083,10 @@ impl WienerFilter {
         let diagonal = |m: &DMatrix<C64>| DMatrix::from_diagonal(&m.diagonal());
         Self::from_parts(
             self.description.clone(),
-            self.spectra.iter().map(diagonal).collect(),
+            self.components
+                .iter()
+                .map(|k| k.spectra.iter().map(diagonal).collect())
+                .collect(),
             DMatrix::from_diagonal(&self.noise.diagonal()),
         )
     }
@@ -866,6 +1114,16 @@ pub struct WienerFitOptions {
     pub seed: u64,
     /// Fit to at most this many training takes (quick runs and tests).
     pub max_train_takes: Option<usize>,
+    /// Fit a mixture ([`fit_mixture`]): one component per content with at
+    /// least this many training segments. `None`: one set of spectra.
+    #[serde(default)]
+    pub mixture_min_segments: Option<usize>,
+    /// With a mixture: build it from the Wiener filter that this network
+    /// model corrects (keeping its noise covariance, so the level the
+    /// network reads means the same) and write that network, not
+    /// retrained, with the mixture under it.
+    #[serde(default)]
+    pub rebase: Option<PathBuf>,
 }
 
 impl Default for WienerFitOptions {
@@ -879,6 +1137,8 @@ impl Default for WienerFitOptions {
             noise_sigma_deg: 5.0,
             seed: 1,
             max_train_takes: None,
+            mixture_min_segments: None,
+            rebase: None,
         }
     }
 }
@@ -901,14 +1161,20 @@ pub fn fit_files(options: &WienerFitOptions) -> Result<WienerFitReport> {
         train_paths.truncate(max);
     }
     let takes = load_takes(&train_paths)?;
+    if let Some(model_path) = &options.rebase {
+        return rebase(options, model_path, &takes, &paths, started);
+    }
     let motions: Vec<&Motion> = takes.iter().map(|t| &t.motion).collect();
-    let filter = WienerFilter::fit(
+    let mut filter = WienerFilter::fit(
         &motions,
         &options.noise,
         options.noise_sigma_deg,
         options.segment,
         options.seed,
     )?;
+    if let Some(min_segments) = options.mixture_min_segments {
+        filter = fit_mixture(&filter, &takes, min_segments)?;
+    }
     let data = DataDescription {
         train_takes: filter.description.takes,
         train_frames: filter.description.frames,
@@ -929,6 +1195,117 @@ pub fn fit_files(options: &WienerFitOptions) -> Result<WienerFitReport> {
         data,
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+/// [`fit_files`] with [`WienerFitOptions::rebase`].
+fn rebase(
+    options: &WienerFitOptions,
+    model_path: &Path,
+    takes: &[Take],
+    paths: &[PathBuf],
+    started: Instant,
+) -> Result<WienerFitReport> {
+    let min_segments = options.mixture_min_segments.ok_or_else(|| {
+        CleanError::Invalid("rebasing a network needs a mixture to put under it".into())
+    })?;
+    let model = crate::infer::CleanModel::load(model_path, Default::default())?;
+    let base = model.base_wiener().cloned().ok_or_else(|| {
+        CleanError::Invalid(format!(
+            "{}: this model corrects no Wiener filter",
+            model_path.display()
+        ))
+    })?;
+    let mixture = fit_mixture(&base, takes, min_segments)?;
+    let description = mixture.description.clone();
+    let model = model.with_base_wiener(mixture)?;
+    let data = DataDescription {
+        train_takes: description.takes,
+        train_frames: description.frames,
+        validation_takes: paths_in_split(paths, Split::Validation, &options.split).len(),
+        ..DataDescription::new(
+            &options.inputs,
+            paths,
+            options.split,
+            description.fps as f64,
+        )
+    };
+    let (mut header_data, training) = crate::infer::CleanModel::header_of(model_path)?;
+    if let Some(record) = header_data.as_object_mut() {
+        record.insert(
+            "rebased".into(),
+            serde_json::json!({
+                "network_from": model_path.display().to_string(),
+                "mixture_min_segments": min_segments,
+                "mixture_data": data,
+            }),
+        );
+    }
+    model.save(&options.out, header_data, training)?;
+    Ok(WienerFitReport {
+        model: options.out.clone(),
+        description,
+        data,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The content of a take named `<set>_<content>_<style>_<take>` (Bandai's
+/// scheme; HDM05's `HDM_<actor>_<class>_...` gives the actor), or `None`
+/// for a name with fewer parts.
+fn content_of(name: &str) -> Option<&str> {
+    let parts: Vec<&str> = name.split('_').collect();
+    (parts.len() >= 3).then_some(parts[1])
+}
+
+/// Welch segments of `segment` frames, half overlapping, in `frames`.
+fn segment_count(frames: usize, segment: usize) -> usize {
+    if frames < segment {
+        0
+    } else {
+        (frames - segment) / (segment / 2) + 1
+    }
+}
+
+/// A mixture (see "Mixture" in the module docs) made from `single`, a
+/// filter fitted to all of `takes`: one component per content named in the
+/// take names (`<set>_<content>_<style>_<take>`) with at least
+/// `min_segments` Welch segments, one for the other takes together, and
+/// `single`'s own spectra as the last component ("all"), for takes unlike
+/// any one content. Takes of another rig than `single`'s are left out.
+pub fn fit_mixture(
+    single: &WienerFilter,
+    takes: &[Take],
+    min_segments: usize,
+) -> Result<WienerFilter> {
+    let segment = single.description.segment;
+    let mut groups: std::collections::BTreeMap<&str, Vec<&Motion>> = Default::default();
+    for take in takes {
+        if single.layout_for(&take.motion).is_ok() {
+            let content = content_of(&take.name).unwrap_or("");
+            groups.entry(content).or_default().push(&take.motion);
+        }
+    }
+    let mut parts = Vec::new();
+    let mut other: Vec<&Motion> = Vec::new();
+    for (content, motions) in groups {
+        let segments: usize = motions
+            .iter()
+            .map(|m| segment_count(m.frame_count(), segment))
+            .sum();
+        if !content.is_empty() && segments >= min_segments {
+            parts.push((content.to_string(), single.with_spectra_of(&motions)?));
+        } else {
+            other.extend(motions);
+        }
+    }
+    if other
+        .iter()
+        .any(|m| segment_count(m.frame_count(), segment) > 0)
+    {
+        parts.push(("other".to_string(), single.with_spectra_of(&other)?));
+    }
+    parts.push(("all".to_string(), single.clone()));
+    WienerFilter::mixture(parts)
 }
 
 /// The names of the joints of `layout` (those with rotation channels).
@@ -981,10 +1358,14 @@ mod tests {
                 frames: 0,
                 segments: 0,
                 other_rig_takes: 0,
+                components: Vec::new(),
+                packed_spectra: false,
             },
-            spectra: Vec::new(),
+            components: vec![Component {
+                spectra: Vec::new(),
+                bins,
+            }],
             noise: DMatrix::zeros(c, c),
-            bins,
         };
         for frames in [0, 1, 5, 31, 32, 33, 100] {
             let x: Vec<f32> = (0..frames * c)
@@ -1086,6 +1467,81 @@ mod tests {
         );
     }
 
+    fn refs(motions: &[Motion]) -> Vec<&Motion> {
+        motions.iter().collect()
+    }
+
+    /// A take of `frames` frames moving ten times as fast as
+    /// `synthetic_motion_phase` (every tenth frame of a longer one), so its
+    /// spectra reach frequencies where the slow one has no power.
+    fn fast_motion(frames: usize, phase: f32) -> Motion {
+        let (skeleton, frame_time, _, values) =
+            synthetic_motion_phase(4 * frames, 5, phase).into_parts();
+        let c = skeleton.channel_count();
+        let kept: Vec<f32> = (0..frames)
+            .flat_map(|f| values[4 * f * c..(4 * f + 1) * c].to_vec())
+            .collect();
+        Motion::new(skeleton, frame_time, frames, kept).unwrap()
+    }
+
+    #[test]
+    fn a_mixture_picks_the_kind_of_motion_of_a_take() {
+        let slow: Vec<Motion> = (0..6)
+            .map(|k| synthetic_motion_phase(240, 5, 0.7 * k as f32))
+            .collect();
+        let fast: Vec<Motion> = (0..6)
+            .map(|k| fast_motion(240, 0.7 * k as f32 + 0.3))
+            .collect();
+        let all: Vec<&Motion> = slow.iter().chain(&fast).collect();
+        let single = WienerFilter::fit(&all, &RandomNoise::default(), 5.0, 32, 1).unwrap();
+        let mixture = WienerFilter::mixture(vec![
+            ("slow".into(), single.with_spectra_of(&refs(&slow)).unwrap()),
+            ("fast".into(), single.with_spectra_of(&refs(&fast)).unwrap()),
+            ("all".into(), single.clone()),
+        ])
+        .unwrap();
+        assert_eq!(mixture.description.component_count(), 3);
+        assert_eq!(mixture.description.takes, 12);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("mixture.safetensors");
+        mixture.save(&path, serde_json::Value::Null).unwrap();
+        let loaded = WienerFilter::load(&path).unwrap();
+        assert_eq!(loaded.description, mixture.description);
+        for (kind, clean) in [
+            (0, synthetic_motion_phase(240, 5, 2.45)),
+            (1, fast_motion(240, 2.75)),
+        ] {
+            let mut rng = ChaCha8Rng::seed_from_u64(11);
+            let noisy = add_random_noise_sigma(&clean, 3.0, &RandomNoise::default(), &mut rng);
+            let (one, _) = single.clean(&noisy, None).unwrap();
+            let (mixed, outcome) = mixture.clean(&noisy, None).unwrap();
+            assert_eq!(outcome.component, kind);
+            let (one, mixed) = (
+                rotation_error_deg(&clean, &one),
+                rotation_error_deg(&clean, &mixed),
+            );
+            // The slow kind's own spectra hold no power where the fast
+            // kind's do, so there its component removes more noise than one
+            // filter for both; the fast kind's component is chosen for
+            // fitting best, which here denoises about as well as one filter.
+            if kind == 0 {
+                assert!(mixed < 0.8 * one, "slow: mixture {mixed}, one filter {one}");
+            } else {
+                assert!(mixed < 0.8 * rotation_error_deg(&clean, &noisy) && mixed < 1.2 * one);
+            }
+            let (again, outcome_again) = loaded.clean(&noisy, None).unwrap();
+            assert_eq!(outcome_again.component, kind);
+            assert!((rotation_error_deg(&clean, &again) - mixed).abs() < 0.01);
+        }
+        // Components of other filters do not mix.
+        let other = WienerFilter::fit(&refs(&slow), &RandomNoise::default(), 5.0, 32, 2).unwrap();
+        assert!(WienerFilter::mixture(vec![
+            ("a".into(), single.with_spectra_of(&refs(&slow)).unwrap()),
+            ("b".into(), other),
+        ])
+        .is_err());
+    }
+
     #[test]
     fn files_round_trip_and_other_rigs_are_refused() {
         let filter = fitted();
@@ -1102,6 +1558,19 @@ mod tests {
         // The file keeps the spectra in f32.
         assert!(rotation_error_deg(&a, &b) < 0.01);
         assert!((sa.sigma_deg - sb.sigma_deg).abs() < 0.15);
+        // Files of before packing (every entry of the spectra) still read,
+        // to the same filter; packed ones are about half their size.
+        let mut unpacked = filter.clone();
+        unpacked.description.packed_spectra = false;
+        let old_path = dir.path().join("unpacked.safetensors");
+        unpacked.save(&old_path, serde_json::Value::Null).unwrap();
+        let (c, _) = WienerFilter::load(&old_path)
+            .unwrap()
+            .clean(&noisy, None)
+            .unwrap();
+        assert!(rotation_error_deg(&a, &c) < 0.01);
+        let size = |p: &Path| std::fs::metadata(p).unwrap().len() as f64;
+        assert!(size(&path) < 0.6 * size(&old_path));
         // A network reader refuses it by name, and the dispatcher knows it.
         let error = crate::infer::CleanModel::load(&path, Default::default())
             .unwrap_err()

@@ -378,6 +378,40 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("0 or more"), "{}", stderr(&out));
 
+    // A mixture: spectra per content named in the file names (here 40
+    // dataset-2 takes of 10 contents), the rest together, and all.
+    let mixture = dir.path().join("mixture.safetensors");
+    let fit_mixture = |min: &str| {
+        mocap(&[
+            "clean",
+            "train",
+            path(&takes),
+            "--wiener",
+            "--mixture",
+            min,
+            "-o",
+            path(&mixture),
+            "--json",
+        ])
+    };
+    let out = fit_mixture("20");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let names: Vec<&str> = report["description"]["components"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert!(
+        names.len() >= 3 && names.last() == Some(&"all"),
+        "{names:?}"
+    );
+    let out = clean_walk_with(&mixture, dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = fit_mixture("0");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+
     // Network options do not go with --wiener.
     let out = mocap(&[
         "clean",

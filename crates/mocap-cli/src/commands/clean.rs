@@ -203,6 +203,16 @@ struct TrainArgs {
     /// With --wiener: frames per Fourier segment (default 32).
     #[arg(long, value_name = "FRAMES", requires = "wiener")]
     segment: Option<usize>,
+    /// With --wiener: fit a mixture, one set of spectra per content named in the file names
+    /// (`<set>_<content>_<style>_<take>`) with at least this many training segments (150 for the
+    /// shipped one), plus one for the rest and one for all; each take is cleaned with the one
+    /// that fits it best.
+    #[arg(long, value_name = "MIN_SEGMENTS", requires = "wiener", value_parser = clap::value_parser!(u32).range(1..))]
+    mixture: Option<u32>,
+    /// With --mixture: build the mixture from the Wiener filter this network model corrects and
+    /// write the network (not retrained) with the mixture under it.
+    #[arg(long, value_name = "MODEL", requires = "mixture")]
+    rebase: Option<PathBuf>,
     /// Training and validation curves as PNG (default: OUTPUT with extension png).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -426,6 +436,8 @@ fn run_fit_wiener(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     };
     set(&mut o.segment, a.segment);
     set(&mut o.seed, a.seed);
+    o.mixture_min_segments = a.mixture.map(|m| m as usize);
+    o.rebase = a.rebase;
     o.noise.perturb_above_pelvis |= a.noise_above_pelvis;
     if !options.quiet && !a.json {
         eprintln!(
@@ -437,6 +449,10 @@ fn run_fit_wiener(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else if !options.quiet {
         let d = &report.description;
+        if !d.components.is_empty() {
+            let names: Vec<&str> = d.components.iter().map(|c| c.name.as_str()).collect();
+            eprintln!("{} components: {}", names.len(), names.join(", "));
+        }
         eprintln!(
             "fitted to {} takes ({} frames, {} segments of {} frames{}) in {:.1} s; wrote {}",
             d.takes,
