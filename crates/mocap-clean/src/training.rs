@@ -1265,6 +1265,17 @@ mod tests {
         (options, wiener_path)
     }
 
+    /// A synthetic take of the tiny setups' rig with 4 degrees of noise.
+    fn noisy_four_joint_take() -> Motion {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        crate::noise::add_random_noise_sigma(
+            &synthetic_motion_phase(90, 4, 0.2),
+            4.0,
+            &crate::noise::RandomNoise::default(),
+            &mut rng,
+        )
+    }
+
     #[test]
     fn a_model_on_a_wiener_filter_carries_it_and_corrects_it() {
         let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
@@ -1277,14 +1288,7 @@ mod tests {
         let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
         let stored = model.description.base_wiener.clone().unwrap();
         assert_eq!(stored.joints.len(), 4);
-        let clean = synthetic_motion_phase(90, 4, 0.2);
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let noisy = crate::noise::add_random_noise_sigma(
-            &clean,
-            4.0,
-            &crate::noise::RandomNoise::default(),
-            &mut rng,
-        );
+        let noisy = noisy_four_joint_take();
         let (trained, noise) = model.clean_reporting(&noisy, None).unwrap();
         assert!(trained.values().iter().all(|v| v.is_finite()));
         // It says the noise level its filter found (4 degrees were added).
@@ -1370,14 +1374,7 @@ mod tests {
         assert_eq!(model_base(&rebased).description.component_count(), 2);
         // The same network on a filter whose components both come from the
         // same takes: nearly the same output.
-        let clean = synthetic_motion_phase(90, 4, 0.2);
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let noisy = crate::noise::add_random_noise_sigma(
-            &clean,
-            4.0,
-            &crate::noise::RandomNoise::default(),
-            &mut rng,
-        );
+        let noisy = noisy_four_joint_take();
         let off = crate::eval::rotation_error_deg(
             &original.clean(&noisy, None).unwrap(),
             &rebased.clean(&noisy, None).unwrap(),
@@ -1460,13 +1457,7 @@ mod tests {
         );
 
         // With no correction the model is still its Wiener filter.
-        let clean = synthetic_motion_phase(90, 4, 0.2);
-        let noisy = crate::noise::add_random_noise_sigma(
-            &clean,
-            4.0,
-            &crate::noise::RandomNoise::default(),
-            &mut ChaCha8Rng::seed_from_u64(5),
-        );
+        let noisy = noisy_four_joint_take();
         model.zero_output();
         let zeroed = model.clean(&noisy, None).unwrap();
         let (filtered, _) = model_base(&model).clean(&noisy, None).unwrap();

@@ -432,23 +432,25 @@ fn style_apply_restyles_the_bundled_walk() {
     let source = sample("dataset-1_walk_normal_001.bvh");
     let style = sample("dataset-1_walk_proud_001.bvh");
     let output = dir.path().join("proud.bvh");
-    let out = mocap(&[
-        "style",
-        "apply",
-        &source,
-        "--style",
-        &style,
-        "-o",
-        path(&output),
-        "--strength",
-        "0.8",
-        "--fade-in",
-        "1s",
-        "--json",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let restyled = read_bvh(&output).unwrap();
+    // Restyles with `extra` options: the JSON report and the output.
+    let restyle = |extra: &[&str]| {
+        let mut args = vec![
+            "style",
+            "apply",
+            &source,
+            "--style",
+            &style,
+            "-o",
+            path(&output),
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = mocap(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (report, read_bvh(&output).unwrap())
+    };
+    let (report, restyled) = restyle(&["--strength", "0.8", "--fade-in", "1s"]);
     let original = read_bvh(Path::new(&source)).unwrap();
     assert_eq!(
         report["output_frames"].as_u64().unwrap() as usize,
@@ -469,25 +471,8 @@ fn style_apply_restyles_the_bundled_walk() {
 
     // With the root carried by the planted feet the same restyle slides its
     // feet less, and says how far they carried it.
-    let full = |extra: &[&str]| {
-        let mut args = vec![
-            "style",
-            "apply",
-            &source,
-            "--style",
-            &style,
-            "-o",
-            path(&output),
-            "--json",
-        ];
-        args.extend_from_slice(extra);
-        let out = mocap(&args);
-        assert!(out.status.success(), "{}", stderr(&out));
-        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        (report, read_bvh(&output).unwrap())
-    };
-    let (path_report, path_motion) = full(&[]);
-    let (feet_report, feet_motion) = full(&["--root-from-feet"]);
+    let (path_report, path_motion) = restyle(&[]);
+    let (feet_report, feet_motion) = restyle(&["--root-from-feet"]);
     assert_eq!(feet_report["root_from_feet"], true);
     assert_eq!(path_motion.frame_count(), feet_motion.frame_count());
     let rig = RigLayout::from_skeleton(path_motion.skeleton()).unwrap();
