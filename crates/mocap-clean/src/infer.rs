@@ -35,7 +35,7 @@ use crate::training::{
     base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
     CHECKPOINT_KIND_VERSION,
 };
-use crate::wiener::{WienerFilter, WIENER_KIND};
+use crate::wiener::{WienerFilter, WienerOutcome, WIENER_KIND};
 use crate::{CleanError, Result};
 
 /// Where the shipped default model lives in the source tree.
@@ -194,6 +194,19 @@ impl CleanModel {
         hop: Option<usize>,
         level_deg: Option<f64>,
     ) -> Result<(Motion, Option<f64>)> {
+        let (out, outcome) = self.clean_describing(motion, hop, level_deg)?;
+        Ok((out, outcome.map(|o| o.sigma_deg)))
+    }
+
+    /// [`CleanModel::clean_at_level`], returning all its Wiener filter says
+    /// of the take (the level and, in a mixture, the component chosen), when
+    /// it corrects one that sees the whole take.
+    pub fn clean_describing(
+        &self,
+        motion: &Motion,
+        hop: Option<usize>,
+        level_deg: Option<f64>,
+    ) -> Result<(Motion, Option<WienerOutcome>)> {
         if self.description.network.head != Head::Correction {
             return Err(CleanError::Invalid(format!(
                 "{} is a spike detector (`mocap clean train --spike-detector`), not a denoiser: \
@@ -218,15 +231,16 @@ impl CleanModel {
             self.description.fps,
             self.base_wiener.as_ref(),
         );
-        let mut noise_deg = None;
+        let mut outcome = None;
         let filtered_take = match &base {
             Some(base) if self.description.base_context > 0 => {
                 let mut filtered = features.clone();
-                noise_deg = base.apply(&mut filtered, c, level_deg);
+                outcome = base.apply_reporting(&mut filtered, c, level_deg);
                 Some(filtered)
             }
             _ => None,
         };
+        let noise_deg = outcome.map(|o| o.sigma_deg);
         // Pad by repeating the edge frames: half a window in front, and at
         // the end enough for the last window to be whole.
         let front = t / 2;
@@ -327,7 +341,7 @@ impl CleanModel {
         }
         let mut out = motion.clone();
         layout.decode_into(&cleaned, &mut out);
-        Ok((out, noise_deg))
+        Ok((out, outcome))
     }
 
     /// The learned filter the network corrects, if it corrects one
@@ -443,10 +457,10 @@ impl ModelFile {
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<(Motion, String)> {
         match self {
             ModelFile::Network(model) => {
-                let (out, noise) = model.clean_reporting(motion, hop)?;
-                let label = match noise {
-                    Some(sigma) => format!("model (noise estimated at {sigma:.1} deg)"),
-                    None => "model".into(),
+                let (out, outcome) = model.clean_describing(motion, hop, None)?;
+                let label = match (outcome, model.base_wiener()) {
+                    (Some(o), Some(wiener)) => format!("model ({})", wiener.describe(&o)),
+                    _ => "model".into(),
                 };
                 Ok((out, label))
             }
@@ -454,10 +468,7 @@ impl ModelFile {
                 let (out, outcome) = filter.clean(motion, None)?;
                 Ok((
                     out,
-                    format!(
-                        "Wiener filter (noise estimated at {:.1} deg)",
-                        outcome.sigma_deg
-                    ),
+                    format!("Wiener filter ({})", filter.describe(&outcome)),
                 ))
             }
         }

@@ -41,7 +41,7 @@ use crate::loss::{binary_cross_entropy_with_logits, derivative_loss, position_lo
 use crate::model::{Denoiser, DenoiserConfig, Head};
 use crate::noise::{add_noise_with_spikes, NoiseConfig, Spike};
 use crate::spikes::spike_mask;
-use crate::wiener::{WienerDescription, WienerFilter};
+use crate::wiener::{WienerDescription, WienerFilter, WienerOutcome};
 use crate::{CleanError, Result};
 
 /// The kind written in checkpoint headers.
@@ -142,12 +142,24 @@ impl<'a> Base<'a> {
         channels: usize,
         level_deg: Option<f64>,
     ) -> Option<f64> {
+        self.apply_reporting(features, channels, level_deg)
+            .map(|outcome| outcome.sigma_deg)
+    }
+
+    /// [`Base::apply`], with all a Wiener filter says of what it did (the
+    /// level and, in a mixture, the component).
+    pub(crate) fn apply_reporting(
+        &self,
+        features: &mut [f32],
+        channels: usize,
+        level_deg: Option<f64>,
+    ) -> Option<WienerOutcome> {
         match self {
             Base::Classical(filter, fps) => {
                 filter_features(features, channels, filter, *fps);
                 None
             }
-            Base::Wiener(wiener) => Some(wiener.filter_features(features, level_deg).sigma_deg),
+            Base::Wiener(wiener) => Some(wiener.filter_features(features, level_deg)),
         }
     }
 }

@@ -1070,6 +1070,16 @@ impl WienerFilter {
         Self::from_tensors(description, tensors).map_err(bad)
     }
 
+    /// What filtering a take did, in words: `noise estimated at 4.2 deg`,
+    /// and for a mixture `, spectra of walk` (the component's name).
+    pub fn describe(&self, outcome: &WienerOutcome) -> String {
+        let level = format!("noise estimated at {:.1} deg", outcome.sigma_deg);
+        match self.description.components.get(outcome.component) {
+            Some(component) => format!("{level}, spectra of {}", component.name),
+            None => level,
+        }
+    }
+
     /// `N`, the per-frame covariance of the noise of the features at
     /// [`WienerDescription::noise_sigma_deg`].
     pub fn noise_covariance(&self) -> &DMatrix<f64> {

@@ -409,6 +409,15 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     );
     let out = clean_walk_with(&mixture, dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
+    // The report names the component that cleaned the take.
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let method = report["method"].as_str().unwrap();
+    assert!(
+        names
+            .iter()
+            .any(|n| method.contains(&format!("spectra of {n}"))),
+        "{method}"
+    );
     let out = fit_mixture("0");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 
