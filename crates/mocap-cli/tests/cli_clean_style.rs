@@ -441,8 +441,8 @@ fn style_apply_restyles_the_bundled_walk() {
     let source = sample("dataset-1_walk_normal_001.bvh");
     let style = sample("dataset-1_walk_proud_001.bvh");
     let output = dir.path().join("proud.bvh");
-    // Restyles with `extra` options: the JSON report and the output.
-    let restyle = |extra: &[&str]| {
+    // `mocap style apply` of the walk in the proud style, with `extra`.
+    let apply = |extra: &[&str]| {
         let mut args = vec![
             "style",
             "apply",
@@ -454,7 +454,11 @@ fn style_apply_restyles_the_bundled_walk() {
             "--json",
         ];
         args.extend_from_slice(extra);
-        let out = mocap(&args);
+        mocap(&args)
+    };
+    // Restyles with `extra` options: the JSON report and the output.
+    let restyle = |extra: &[&str]| {
+        let out = apply(extra);
         assert!(out.status.success(), "{}", stderr(&out));
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         (report, read_bvh(&output).unwrap())
@@ -498,17 +502,7 @@ fn style_apply_restyles_the_bundled_walk() {
     assert!((0.7..1.3).contains(&ratio), "distance ratio {ratio}");
 
     // A bad duration and a missing style clip are input errors (1).
-    let out = mocap(&[
-        "style",
-        "apply",
-        &source,
-        "--style",
-        &style,
-        "-o",
-        path(&output),
-        "--fade-in",
-        "soon",
-    ]);
+    let out = apply(&["--fade-in", "soon"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("--fade-in"), "{}", stderr(&out));
     let out = mocap(&[
