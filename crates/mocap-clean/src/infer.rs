@@ -358,19 +358,14 @@ impl CleanModel {
         let own = self.base_wiener.as_ref().ok_or_else(|| {
             CleanError::Invalid("this model corrects no Wiener filter to replace".into())
         })?;
-        let (a, b) = (&own.description, &wiener.description);
-        if a.joints != b.joints
-            || a.segment != b.segment
-            || a.noise_sigma_deg != b.noise_sigma_deg
-            || own.noise_covariance() != wiener.noise_covariance()
-        {
+        if !own.same_noise_model(&wiener) {
             return Err(CleanError::Invalid(
                 "the new Wiener filter differs from the model's in rig, segment or noise \
                  covariance"
                     .into(),
             ));
         }
-        self.description.base_wiener = Some(b.clone());
+        self.description.base_wiener = Some(wiener.description.clone());
         self.base_wiener = Some(wiener);
         Ok(self)
     }

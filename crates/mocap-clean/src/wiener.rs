@@ -356,9 +356,8 @@ fn welch_spectra(
             let (x, _) = centred(&layout.encode(m), c);
             let frames = x.len() / c;
             let mut sums = vec![DMatrix::<C64>::zeros(c, c); bins];
-            let mut count = 0;
-            let mut start = 0;
-            while start + segment <= frames {
+            let count = segment_count(frames, segment);
+            for start in (0..count).map(|k| k * segment / 2) {
                 let spectrum = transforms.segment_spectrum(&x, c, start, &window);
                 for (b, sum) in sums.iter_mut().enumerate() {
                     let column = spectrum.column(b);
@@ -369,8 +368,6 @@ fn welch_spectra(
                         C64::new(1.0, 0.0),
                     );
                 }
-                count += 1;
-                start += segment / 2;
             }
             (sums, count)
         })
@@ -513,35 +510,42 @@ impl WienerFilter {
         };
         let noise = first.noise.clone();
         let mut components = Vec::new();
-        for (name, filter) in parts {
-            let d = &filter.description;
-            if filter.components.len() != 1
-                || filter.noise != noise
-                || d.joints != description.joints
-                || d.segment != description.segment
-            {
+        for (name, filter) in &parts {
+            if filter.components.len() != 1 || !filter.same_noise_model(first) {
                 return Err(CleanError::Invalid(format!(
                     "the mixture's component {name} is not a single filter with the same rig, \
                      segment and noise covariance as the first"
                 )));
             }
+            let d = &filter.description;
             // The components may share takes (an "all" component): the
             // mixture was fitted to as many as its largest one.
             description.takes = description.takes.max(d.takes);
             description.frames = description.frames.max(d.frames);
             description.segments = description.segments.max(d.segments);
             description.components.push(ComponentInfo {
-                name,
+                name: name.clone(),
                 takes: d.takes,
                 segments: d.segments,
             });
-            components.extend(filter.components);
+            components.extend(filter.components.iter().cloned());
         }
         Ok(WienerFilter {
             description,
             components,
             noise,
         })
+    }
+
+    /// Whether `other` reads takes as this filter does: the same rig,
+    /// segment and noise covariance `N` at the same level, so that their
+    /// levels mean the same and their likelihoods (2) compare.
+    pub fn same_noise_model(&self, other: &WienerFilter) -> bool {
+        let (a, b) = (&self.description, &other.description);
+        a.joints == b.joints
+            && a.segment == b.segment
+            && a.noise_sigma_deg == b.noise_sigma_deg
+            && self.noise == other.noise
     }
 
     /// Builds the per-bin bases of (1) from each component's spectra and `N`.

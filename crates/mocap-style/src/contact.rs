@@ -201,13 +201,12 @@ impl Default for RootFromFeetOptions {
 /// height above its ground and horizontal speed), which is the one a real
 /// foot pivots on: the heel after it strikes, the ball of the foot as the
 /// heel rises. With no foot near the ground the root keeps its own step.
-/// The steps are then smoothed along time. Returns the mean horizontal
-/// distance between the new and the old root, in file units.
-pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFeetOptions) -> f32 {
+/// The steps are then smoothed along time.
+pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFeetOptions) {
     let poses = forward_kinematics(motion);
     let n = poses.frame_count;
     if n < 2 {
-        return 0.0;
+        return;
     }
     let up = up_axis(&poses.positions, poses.joint_count, rig);
     let horizontal = |p: Vec3| p - up * p.dot(up);
@@ -267,15 +266,12 @@ pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFe
     let steps = smooth_steps(&steps, options.smoothing_seconds * motion.fps() as f32);
     let parent = motion.skeleton().joint(rig.pelvis).parent;
     let mut shift = Vec3::ZERO;
-    let mut moved = 0.0f32;
     for f in 1..n {
         shift += steps[f] - own[f];
-        moved += shift.length();
         let to_local = parent.map_or(Quat::IDENTITY, |p| poses.rotation(f, p).inverse());
         let t = motion.local_translation(f, rig.pelvis);
         motion.set_local_translation(f, rig.pelvis, t + to_local * shift);
     }
-    moved / n as f32
 }
 
 /// Horizontal distance the pelvis travels over the clip (file units): the

@@ -623,6 +623,7 @@ fn evaluate_set(
     let mut source_rows = Vec::new();
     let bar = mocap_nn::train::work_bar(sources.len() as u64, &format!("{set}: sources restyled"));
     for source in &sources {
+        let source_distance = travelled(&source.motion, rig);
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
                 continue;
@@ -652,7 +653,7 @@ fn evaluate_set(
                     foot_skating: foot_skating(out, rig),
                     jitter: motion_jitter(out),
                     time_scale: out.duration() / source.motion.duration(),
-                    distance_ratio: (travelled(out, rig) / travelled(&source.motion, rig)) as f64,
+                    distance_ratio: (travelled(out, rig) / source_distance) as f64,
                     timings: restyled.timings,
                 });
             }
