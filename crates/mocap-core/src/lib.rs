@@ -7,6 +7,7 @@
 //! - [`kinematics`]: forward kinematics;
 //! - [`bodymap`]: semantic body parts located by joint name, and mirroring;
 //! - [`ops`]: resample, trim, mirror, scale;
+//! - [`retarget`]: a motion played by another rig of the same body map;
 //! - [`metrics`]: position and rotation errors, bone-length statistics;
 //! - [`io`]: BVH and ASF/AMC files, and atomic writes.
 
@@ -17,6 +18,7 @@ pub mod kinematics;
 pub mod metrics;
 pub mod motion;
 pub mod ops;
+pub mod retarget;
 pub mod rotation;
 pub mod skeleton;
 

@@ -3,13 +3,14 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context};
 use mocap_core::io::{self, MotionSource};
 use mocap_core::ops;
+use mocap_core::retarget::Retargeting;
 
 use super::GlobalOptions;
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Steps run in this order: join inputs, --frames, --fps, --mirror, --scale.\n\
-Examples:\n  mocap convert walk.bvh --fps 30 walk30.bvh\n  mocap convert HDM_bd.asf HDM_bd_walk.amc walk.bvh\n  mocap convert take.bvh --frames 100..400 --mirror clip.bvh"
+    after_help = "Steps run in this order: join inputs, --frames, --fps, --mirror, --scale, --retarget-to.\n\
+Examples:\n  mocap convert walk.bvh --fps 30 walk30.bvh\n  mocap convert HDM_bd.asf HDM_bd_walk.amc walk.bvh\n  mocap convert take.bvh --frames 100..400 --mirror clip.bvh\n  mocap convert cmu_walk.bvh --retarget-to mixamo_character.bvh walk_on_mixamo.bvh"
 )]
 pub struct Args {
     /// Inputs then the output: `IN.bvh OUT.bvh`, `X.asf X.amc OUT.bvh`, or several
@@ -28,6 +29,11 @@ pub struct Args {
     /// Keep frames A..B (0-based, B excluded; `A..` to the end).
     #[arg(long, value_name = "A..B")]
     frames: Option<String>,
+    /// Play the motion on the rig of this BVH file (its hierarchy and offsets; its frames are
+    /// not read): body parts matched by joint name, bone directions kept, strides scaled by
+    /// the legs' lengths.
+    #[arg(long, value_name = "RIG.bvh")]
+    retarget_to: Option<PathBuf>,
 }
 
 /// Parses `A..B` or `A..` into a frame range for a take of `len` frames.
@@ -75,6 +81,12 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
     }
     if let Some(factor) = args.scale {
         motion = ops::scale(&motion, factor);
+    }
+    if let Some(rig) = &args.retarget_to {
+        let target = io::bvh::read_bvh(rig)?;
+        motion = Retargeting::detect(motion.skeleton(), target.skeleton())
+            .and_then(|r| r.apply(&motion))
+            .with_context(|| format!("retargeting onto the rig of {}", rig.display()))?;
     }
     io::write_motion(output, &motion)?;
     Ok(())

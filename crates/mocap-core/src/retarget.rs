@@ -1,0 +1,483 @@
+//! Retargeting: a motion of one rig played by another rig of the same body
+//! map (joint names, hierarchy, bone lengths and rest pose may all differ).
+//!
+//! The two rigs are matched by their [`BodyMap`]s. A body part both rigs
+//! have is *mapped*; its joint on the target takes the global rotation of
+//! the source's joint, corrected for how the two rest poses differ:
+//!
+//! ```text
+//! G_t(j_t, f) = G_s(j_s, f) F_s(p) F_t(p)^-1                           (1)
+//! ```
+//!
+//! where `G` are global rotations (forward kinematics) and `F(p)` is the
+//! *rest frame* of part `p` on each rig: its bone's direction at rest (from
+//! the part's joint to the next part down the chain, e.g. shoulder to elbow,
+//! measured between joint positions so that joints in between do not
+//! matter) and, for the twist about it, a body axis of the rest pose (the
+//! forward axis, or the left-right axis where the bone points forward, as a
+//! foot does; the pelvis and the chest use the left-right axis of the hips
+//! and of the shoulders, taken where the way to them leaves the joint, e.g.
+//! at the clavicles' start, which turns with the chest alone). At the
+//! source's rest pose (1) puts the target in
+//! the source's rest pose, bone for bone, whatever each rig's own rest pose
+//! is (a T-pose, an A-pose, or Bandai's, whose bones all lie along x). Parts
+//! with no part below them (head, hands, toes, or a wrist where one rig has
+//! no hand) borrow the rest-frame correction of the part above them.
+//!
+//! Target joints of no part keep their rest rotation relative to their
+//! parent, except a joint between two mapped parts (a clavicle between the
+//! chest and the shoulder point, CMU's `LHipJoint` between the pelvis and
+//! the hip): it is turned so that the next mapped joint below it lands
+//! where the source has it relative to the mapped joint above (scaled), so
+//! shoulders keep their width and height. Joints above the pelvis keep
+//! their rest rotation; the root's translation puts the pelvis where the
+//! source's is, scaled by the ratio of the rigs' leg lengths (hip to knee to
+//! ankle at rest), so strides fit the new legs and the floor stays at the
+//! height it was.
+//!
+//! Both rigs are taken to be in the same world frame (the same up axis and
+//! units of their own). What is lost: motion of joints the source has and
+//! the target has no part for (fingers, extra spine joints are folded into
+//! the mapped ones), and twist where the rigs' rest poses disagree about it.
+
+use crate::bodymap::{BodyMap, BodyPart};
+use crate::error::{Error, Result};
+use crate::kinematics::forward_kinematics;
+use crate::motion::Motion;
+use crate::rotation::{Mat3, Quat, Vec3};
+use crate::skeleton::Skeleton;
+
+/// What a target joint does during retargeting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role {
+    /// Keeps its rest rotation relative to its parent.
+    Rest,
+    /// Takes the global rotation of source joint `source`, times `correction`
+    /// (`F_s F_t^-1` of (1)).
+    Mapped { source: usize, correction: Quat },
+    /// Turned so that target joint `below` lands where source joint
+    /// `source_below` is relative to `source_above`, target joint `above`
+    /// standing for it (see the module docs).
+    Aimed {
+        below: usize,
+        above: usize,
+        source_below: usize,
+        source_above: usize,
+    },
+}
+
+/// A retargeting from one rig to another, prepared once and applied to any
+/// number of motions of the source rig.
+#[derive(Debug, Clone)]
+pub struct Retargeting {
+    source: Skeleton,
+    target: Skeleton,
+    roles: Vec<Role>,
+    /// Target pelvis joint and source pelvis joint.
+    pelvis: (usize, usize),
+    /// The target's root joint.
+    root: usize,
+    scale: f32,
+}
+
+/// The next part down the chain from `part` whose bone direction gives the
+/// part's rest frame (the first of the candidates both rigs have).
+fn bone_candidates(part: BodyPart) -> &'static [BodyPart] {
+    use BodyPart::*;
+    match part {
+        Pelvis => &[Spine, Chest, Neck, Head],
+        Spine => &[Chest, Neck, Head],
+        Chest => &[Neck, Head],
+        Neck => &[Head],
+        LeftShoulder => &[LeftElbow],
+        LeftElbow => &[LeftWrist],
+        LeftWrist => &[LeftHand],
+        LeftHip => &[LeftKnee],
+        LeftKnee => &[LeftAnkle],
+        LeftAnkle => &[LeftToe],
+        RightShoulder => &[RightElbow],
+        RightElbow => &[RightWrist],
+        RightWrist => &[RightHand],
+        RightHip => &[RightKnee],
+        RightKnee => &[RightAnkle],
+        RightAnkle => &[RightToe],
+        Head | LeftHand | RightHand | LeftToe | RightToe => &[],
+    }
+}
+
+/// The part above `part` (whose correction a part without a bone borrows).
+fn part_above(part: BodyPart) -> Option<BodyPart> {
+    use BodyPart::*;
+    Some(match part {
+        Pelvis => return None,
+        Spine => Pelvis,
+        Chest => Spine,
+        Neck => Chest,
+        Head => Neck,
+        LeftShoulder | RightShoulder => Chest,
+        LeftElbow => LeftShoulder,
+        LeftWrist => LeftElbow,
+        LeftHand => LeftWrist,
+        RightElbow => RightShoulder,
+        RightWrist => RightElbow,
+        RightHand => RightWrist,
+        LeftHip | RightHip => Pelvis,
+        LeftKnee => LeftHip,
+        LeftAnkle => LeftKnee,
+        LeftToe => LeftAnkle,
+        RightKnee => RightHip,
+        RightAnkle => RightKnee,
+        RightToe => RightAnkle,
+    })
+}
+
+/// One rig at rest: joint positions and the body's axes.
+struct RestRig<'a> {
+    skeleton: &'a Skeleton,
+    map: &'a BodyMap,
+    positions: Vec<Vec3>,
+    /// From the right hip to the left, as seen from the pelvis joint.
+    lateral: Vec3,
+    /// From the right shoulder to the left, as seen from the chest joint.
+    shoulders: Option<Vec3>,
+    forward: Vec3,
+}
+
+impl<'a> RestRig<'a> {
+    fn new(skeleton: &'a Skeleton, map: &'a BodyMap, what: &str) -> Result<RestRig<'a>> {
+        let rest = Motion::rest(skeleton.clone(), 1.0, 1)?;
+        let positions = forward_kinematics(&rest).frame_positions(0).to_vec();
+        let mut rig = RestRig {
+            skeleton,
+            map,
+            positions,
+            lateral: Vec3::ZERO,
+            shoulders: None,
+            forward: Vec3::ZERO,
+        };
+        let pelvis = map.require(BodyPart::Pelvis)?;
+        rig.lateral = rig
+            .across(pelvis, BodyPart::LeftHip, BodyPart::RightHip)
+            .unwrap_or(Vec3::ZERO)
+            .normalize_or_zero();
+        let top = [
+            BodyPart::Spine,
+            BodyPart::Chest,
+            BodyPart::Neck,
+            BodyPart::Head,
+        ]
+        .into_iter()
+        .find_map(|p| map.joint(p))
+        .ok_or_else(|| Error::Invalid(format!("the {what} rig has no spine or head")))?;
+        let up = rig.toward(pelvis, top) - rig.positions[pelvis];
+        let up = (up - up.dot(rig.lateral) * rig.lateral).normalize_or_zero();
+        if rig.lateral == Vec3::ZERO || up == Vec3::ZERO {
+            return Err(Error::Invalid(format!(
+                "the {what} rig's rest pose has its hips at one point or its spine along the hips: \
+                 cannot tell its body axes"
+            )));
+        }
+        rig.forward = rig.lateral.cross(up);
+        rig.shoulders = map
+            .joint(BodyPart::Chest)
+            .and_then(|chest| rig.across(chest, BodyPart::LeftShoulder, BodyPart::RightShoulder));
+        Ok(rig)
+    }
+
+    fn position(&self, part: BodyPart) -> Option<Vec3> {
+        self.map.joint(part).map(|j| self.positions[j])
+    }
+
+    /// Where the way from `from` to `to` leaves `from`: the child of `from`
+    /// on it, if that one is away from `from` (it then turns with `from`
+    /// alone, as a clavicle's start turns with the chest), else `to`.
+    fn toward(&self, from: usize, to: usize) -> Vec3 {
+        let mut k = to;
+        while let Some(p) = self.skeleton.joint(k).parent {
+            if p == from {
+                let start = self.positions[k];
+                if start.distance(self.positions[from]) > 1e-4 {
+                    return start;
+                }
+                break;
+            }
+            k = p;
+        }
+        self.positions[to]
+    }
+
+    /// From part `right` to part `left` as seen from joint `from` (see
+    /// [`RestRig::toward`]), if both parts exist and lie apart.
+    fn across(&self, from: usize, left: BodyPart, right: BodyPart) -> Option<Vec3> {
+        let (l, r) = (self.map.joint(left)?, self.map.joint(right)?);
+        let (a, b) = (self.toward(from, l), self.toward(from, r));
+        let v = if a.distance(b) > 1e-4 {
+            a - b
+        } else {
+            self.positions[l] - self.positions[r]
+        };
+        (v.length() > 1e-6).then_some(v)
+    }
+}
+
+/// The rest frame of a bone along `direction` with its twist fixed by
+/// `secondary` (columns: direction, `secondary` made perpendicular, their
+/// cross product).
+fn frame(direction: Vec3, secondary: Vec3) -> Quat {
+    let x = direction.normalize();
+    let y = (secondary - secondary.dot(x) * x).normalize();
+    Quat::from_mat3(&Mat3::from_cols(x, y, x.cross(y))).normalize()
+}
+
+impl Retargeting {
+    /// Prepares retargeting from `source` to `target`, located by their body
+    /// maps. Fails when the rigs share no bone to match (a required part of
+    /// [`BodyMap::detect`] missing from a hand-made map).
+    pub fn new(
+        source: &Skeleton,
+        source_map: &BodyMap,
+        target: &Skeleton,
+        target_map: &BodyMap,
+    ) -> Result<Retargeting> {
+        let rest_s = RestRig::new(source, source_map, "source")?;
+        let rest_t = RestRig::new(target, target_map, "target")?;
+        let both = |p: BodyPart| source_map.joint(p).is_some() && target_map.joint(p).is_some();
+        let leg = |rig: &RestRig| -> Result<f32> {
+            let mut sum = 0.0;
+            for [hip, knee, ankle] in [
+                [BodyPart::LeftHip, BodyPart::LeftKnee, BodyPart::LeftAnkle],
+                [
+                    BodyPart::RightHip,
+                    BodyPart::RightKnee,
+                    BodyPart::RightAnkle,
+                ],
+            ] {
+                let at = |p| rig.map.require(p).map(|j| rig.positions[j]);
+                sum += at(hip)?.distance(at(knee)?) + at(knee)?.distance(at(ankle)?);
+            }
+            Ok(sum / 2.0)
+        };
+        let (leg_s, leg_t) = (leg(&rest_s)?, leg(&rest_t)?);
+        if !(leg_s > 0.0 && leg_t > 0.0) {
+            return Err(Error::Invalid(
+                "a rig's legs have no length at rest: cannot scale between the rigs".into(),
+            ));
+        }
+        // Rest-frame corrections F_s F_t^-1 of (1), parts in order so that a
+        // part without a bone finds its parent's.
+        let mut corrections: [Option<Quat>; BodyPart::COUNT] = [None; BodyPart::COUNT];
+        for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
+            let below = bone_candidates(part).iter().copied().find(|&p| both(p));
+            let correction = match below {
+                Some(below) => {
+                    let bone = |rig: &RestRig| {
+                        rig.position(below).unwrap_or_default()
+                            - rig.position(part).unwrap_or_default()
+                    };
+                    let (bone_s, bone_t) = (bone(&rest_s), bone(&rest_t));
+                    if bone_s.length() < 1e-6 || bone_t.length() < 1e-6 {
+                        None
+                    } else {
+                        // The forward axis fixes the twist, unless the
+                        // bone points (nearly) forward on either rig.
+                        let along_forward = bone_s.normalize().dot(rest_s.forward).abs() >= 0.8
+                            || bone_t.normalize().dot(rest_t.forward).abs() >= 0.8;
+                        let secondary = |rig: &RestRig| match part {
+                            BodyPart::Pelvis => rig.lateral,
+                            BodyPart::Chest => rig.shoulders.unwrap_or(rig.lateral),
+                            _ if along_forward => rig.lateral,
+                            _ => rig.forward,
+                        };
+                        let f_s = frame(bone_s, secondary(&rest_s));
+                        let f_t = frame(bone_t, secondary(&rest_t));
+                        Some(f_s * f_t.inverse())
+                    }
+                }
+                None => None,
+            };
+            corrections[part.index()] = correction.or_else(|| {
+                let mut above = part_above(part);
+                while let Some(a) = above {
+                    if let Some(c) = corrections[a.index()] {
+                        return Some(c);
+                    }
+                    above = part_above(a);
+                }
+                Some(Quat::IDENTITY)
+            });
+        }
+        let n = target.joint_count();
+        let mut roles = vec![Role::Rest; n];
+        // Target joint -> source joint, for mapped parts.
+        let mut counterpart = vec![None; n];
+        for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
+            let (j_t, j_s) = (target_map.joint(part), source_map.joint(part));
+            if let (Some(j_t), Some(j_s), Some(correction)) = (j_t, j_s, corrections[part.index()])
+            {
+                roles[j_t] = Role::Mapped {
+                    source: j_s,
+                    correction,
+                };
+                counterpart[j_t] = Some(j_s);
+            }
+        }
+        let pelvis_t = target_map.require(BodyPart::Pelvis)?;
+        let pelvis_s = source_map.require(BodyPart::Pelvis)?;
+        // Joints between two mapped ones are aimed at the one below.
+        for j in 0..n {
+            if counterpart[j].is_some() || !target.subtree(pelvis_t).contains(&j) {
+                continue;
+            }
+            let mut above = target.joint(j).parent;
+            while let Some(a) = above {
+                if counterpart[a].is_some() {
+                    break;
+                }
+                above = target.joint(a).parent;
+            }
+            // The nearest mapped joint below, breadth first.
+            let below = target
+                .subtree(j)
+                .into_iter()
+                .filter(|&k| counterpart[k].is_some())
+                .min_by_key(|&k| depth(target, k));
+            if let (Some(a), Some(b)) = (above, below) {
+                roles[j] = Role::Aimed {
+                    below: b,
+                    above: a,
+                    source_below: counterpart[b].expect("mapped"),
+                    source_above: counterpart[a].expect("mapped"),
+                };
+            }
+        }
+        Ok(Retargeting {
+            source: source.clone(),
+            target: target.clone(),
+            roles,
+            pelvis: (pelvis_t, pelvis_s),
+            root: (0..n)
+                .find(|&j| target.joint(j).parent.is_none())
+                .unwrap_or(0),
+            scale: leg_t / leg_s,
+        })
+    }
+
+    /// Prepares retargeting between two rigs whose body maps the built-in
+    /// rig tables find ([`BodyMap::detect`]).
+    pub fn detect(source: &Skeleton, target: &Skeleton) -> Result<Retargeting> {
+        let source_map =
+            BodyMap::detect(source).map_err(|e| Error::Invalid(format!("the source rig: {e}")))?;
+        let target_map =
+            BodyMap::detect(target).map_err(|e| Error::Invalid(format!("the target rig: {e}")))?;
+        Retargeting::new(source, &source_map, target, &target_map)
+    }
+
+    /// Target leg length over source leg length: how root translations are
+    /// scaled.
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
+    /// The target rig.
+    pub fn target(&self) -> &Skeleton {
+        &self.target
+    }
+
+    /// `motion` (of the source rig) played by the target rig, at the same
+    /// frame rate.
+    pub fn apply(&self, motion: &Motion) -> Result<Motion> {
+        let skeleton = motion.skeleton();
+        if skeleton.joint_count() != self.source.joint_count()
+            || skeleton
+                .joints()
+                .iter()
+                .zip(self.source.joints())
+                .any(|(a, b)| a.name != b.name || a.parent != b.parent)
+        {
+            return Err(Error::Invalid(
+                "this motion is not of the rig the retargeting was prepared for".into(),
+            ));
+        }
+        let frames = motion.frame_count();
+        let source = forward_kinematics(motion);
+        let mut out = Motion::rest(self.target.clone(), motion.frame_time(), frames)?;
+        let n = self.target.joint_count();
+        let (pelvis_t, pelvis_s) = self.pelvis;
+        let mut rotations = vec![Quat::IDENTITY; n];
+        let mut positions = vec![Vec3::ZERO; n];
+        for f in 0..frames {
+            for j in 0..n {
+                let parent = self.target.joint(j).parent;
+                let (parent_rotation, parent_position) = parent
+                    .map_or((Quat::IDENTITY, Vec3::ZERO), |p| {
+                        (rotations[p], positions[p])
+                    });
+                let translation = out.local_translation(f, j);
+                positions[j] = parent_position + parent_rotation * translation;
+                let global = match self.roles[j] {
+                    Role::Rest => parent_rotation,
+                    Role::Mapped {
+                        source: s,
+                        correction,
+                    } => source.rotation(f, s) * correction,
+                    Role::Aimed {
+                        below,
+                        above,
+                        source_below,
+                        source_above,
+                    } => {
+                        // Where `below` hangs from `j` at rest, and where it
+                        // should be.
+                        let mut rest_vector = Vec3::ZERO;
+                        let mut k = below;
+                        while k != j {
+                            let joint = self.target.joint(k);
+                            let parent = joint.parent.expect("below j");
+                            rest_vector = out.local_translation(f, k) + rest_vector;
+                            k = parent;
+                        }
+                        let wanted = positions[above]
+                            + self.scale
+                                * (source.position(f, source_below)
+                                    - source.position(f, source_above))
+                            - positions[j];
+                        let current = parent_rotation * rest_vector;
+                        if current.length() < 1e-6 || wanted.length() < 1e-6 {
+                            parent_rotation
+                        } else {
+                            Quat::from_rotation_arc(current.normalize(), wanted.normalize())
+                                * parent_rotation
+                        }
+                    }
+                };
+                out.set_local_rotation(f, j, parent_rotation.inverse() * global);
+                // What the channels hold (a joint may lack rotation channels).
+                rotations[j] = parent_rotation * out.local_rotation(f, j);
+            }
+            // The pelvis goes where the source's is: by its own position
+            // channels where it has them (Bandai's rig keeps its root still
+            // and moves the pelvis), else by the root's. Joints above the
+            // pelvis are at rest, so a shift of either is a shift in the world.
+            let shift = self.scale * source.position(f, pelvis_s) - positions[pelvis_t];
+            let moved = if self.target.joint(pelvis_t).has_position_channels() {
+                pelvis_t
+            } else {
+                self.root
+            };
+            let translation = out.local_translation(f, moved);
+            out.set_local_translation(f, moved, translation + shift);
+        }
+        Ok(out)
+    }
+}
+
+/// Number of joints above `joint`.
+fn depth(skeleton: &Skeleton, joint: usize) -> usize {
+    let mut d = 0;
+    let mut j = joint;
+    while let Some(p) = skeleton.joint(j).parent {
+        d += 1;
+        j = p;
+    }
+    d
+}

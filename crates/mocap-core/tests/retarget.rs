@@ -1,0 +1,209 @@
+//! Retargeting between rigs: the bundled Bandai walk onto copies of its own
+//! rig with other rest poses and sizes, and real Bandai takes played by the
+//! CMU-style and Mixamo rigs of the parser cases and back.
+
+use mocap_testdata::{sample_walk, shared_data};
+
+use mocap_core::bodymap::{BodyMap, BodyPart};
+use mocap_core::io::bvh::read_bvh;
+use mocap_core::ops::scale;
+use mocap_core::retarget::Retargeting;
+use mocap_core::rotation::{Quat, Vec3};
+use mocap_core::{forward_kinematics, GlobalPoses, Joint, Motion, Skeleton};
+
+/// The limb bones, as (upper part, lower part).
+const BONES: [(BodyPart, BodyPart); 11] = [
+    (BodyPart::LeftShoulder, BodyPart::LeftElbow),
+    (BodyPart::LeftElbow, BodyPart::LeftWrist),
+    (BodyPart::RightShoulder, BodyPart::RightElbow),
+    (BodyPart::RightElbow, BodyPart::RightWrist),
+    (BodyPart::LeftHip, BodyPart::LeftKnee),
+    (BodyPart::LeftKnee, BodyPart::LeftAnkle),
+    (BodyPart::RightHip, BodyPart::RightKnee),
+    (BodyPart::RightKnee, BodyPart::RightAnkle),
+    (BodyPart::LeftAnkle, BodyPart::LeftToe),
+    (BodyPart::RightAnkle, BodyPart::RightToe),
+    (BodyPart::Neck, BodyPart::Head),
+];
+
+/// Largest angle (degrees) between the same limb bone of two motions, over
+/// all frames and the bones both rigs have.
+fn worst_bone_angle(a: &Motion, b: &Motion) -> f32 {
+    let (ma, mb) = (
+        BodyMap::detect(a.skeleton()).unwrap(),
+        BodyMap::detect(b.skeleton()).unwrap(),
+    );
+    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
+    let bone = |p: &GlobalPoses, m: &BodyMap, f, (u, l): (BodyPart, BodyPart)| {
+        Some((p.position(f, m.joint(l)?) - p.position(f, m.joint(u)?)).normalize())
+    };
+    let mut worst = 0.0f32;
+    for f in 0..a.frame_count() {
+        for b in BONES {
+            if let (Some(x), Some(y)) = (bone(&pa, &ma, f, b), bone(&pb, &mb, f, b)) {
+                worst = worst.max(x.angle_between(y).to_degrees());
+            }
+        }
+    }
+    worst
+}
+
+/// Largest distance between the same joint of two motions of one rig, and
+/// that joint's name.
+fn worst_joint_distance(a: &Motion, b: &Motion) -> (f32, String) {
+    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
+    let mut worst = (0.0f32, String::new());
+    for f in 0..a.frame_count() {
+        for j in 0..a.skeleton().joint_count() {
+            let d = pa.position(f, j).distance(pb.position(f, j));
+            if d > worst.0 {
+                worst = (d, a.skeleton().joint(j).name.clone());
+            }
+        }
+    }
+    worst
+}
+
+/// `skeleton` in another rest pose: the same bones, each joint below the
+/// pelvis turned at rest by a rotation of its own (the rest pose of a rig is
+/// where every rotation is zero, so the turned pose becomes the offsets).
+fn other_rest_pose(skeleton: &Skeleton) -> Skeleton {
+    let n = skeleton.joint_count();
+    let mut global = vec![Quat::IDENTITY; n];
+    let mut joints: Vec<Joint> = skeleton.joints().to_vec();
+    for j in 0..n {
+        let parent = skeleton.joint(j).parent;
+        let above = parent.map_or(Quat::IDENTITY, |p| global[p]);
+        let turn = if j > 1 {
+            let axis = Vec3::new(1.0, j as f32, 0.5 * j as f32).normalize();
+            Quat::from_axis_angle(axis, 0.3 * j as f32)
+        } else {
+            Quat::IDENTITY
+        };
+        global[j] = above * turn;
+        joints[j].offset = above * skeleton.joint(j).offset;
+        for end in &mut joints[j].end_sites {
+            *end = global[j] * *end;
+        }
+    }
+    Skeleton::new(joints).unwrap()
+}
+
+#[test]
+fn a_take_played_by_its_own_rig_in_another_rest_pose_and_size_is_unchanged() {
+    let take = read_bvh(&sample_walk()).unwrap();
+    let same = Retargeting::detect(take.skeleton(), take.skeleton()).unwrap();
+    assert_eq!(same.scale(), 1.0);
+    let (d, joint) = worst_joint_distance(&take, &same.apply(&take).unwrap());
+    assert!(d < 0.01, "{joint} moved by {d} cm");
+
+    // Other rest pose: the bones keep their directions, so the joints their
+    // places (the clavicle is aimed at the shoulder, reachable here).
+    let posed = other_rest_pose(take.skeleton());
+    let moved = Retargeting::detect(take.skeleton(), &posed)
+        .unwrap()
+        .apply(&take)
+        .unwrap();
+    let (a, b) = (forward_kinematics(&take), forward_kinematics(&moved));
+    for f in 0..take.frame_count() {
+        for j in 1..take.skeleton().joint_count() {
+            let d = a.position(f, j).distance(b.position(f, j));
+            assert!(
+                d < 0.05,
+                "frame {f}: {} {d} cm off",
+                take.skeleton().joint(j).name
+            );
+        }
+    }
+
+    // Half the size: every position halves, strides included.
+    let small = scale(&take, 0.5);
+    let halved = Retargeting::detect(take.skeleton(), small.skeleton()).unwrap();
+    assert!((halved.scale() - 0.5).abs() < 1e-5);
+    let c = forward_kinematics(&halved.apply(&take).unwrap());
+    for f in 0..take.frame_count() {
+        for j in 1..take.skeleton().joint_count() {
+            let d = (0.5 * a.position(f, j)).distance(c.position(f, j));
+            assert!(
+                d < 0.05,
+                "frame {f}: {} {d} cm off",
+                take.skeleton().joint(j).name
+            );
+        }
+    }
+}
+
+#[test]
+fn a_motion_of_another_rig_or_a_rig_without_body_parts_is_refused() {
+    let take = read_bvh(&sample_walk()).unwrap();
+    let same = Retargeting::detect(take.skeleton(), take.skeleton()).unwrap();
+    let two = Skeleton::new(vec![
+        Joint::new("Base", None, Vec3::ZERO),
+        Joint::new("End", Some(0), Vec3::X),
+    ])
+    .unwrap();
+    let other = Motion::rest(two.clone(), 1.0 / 30.0, 3).unwrap();
+    let e = same.apply(&other).unwrap_err().to_string();
+    assert!(e.contains("not of the rig"), "{e}");
+    let e = Retargeting::detect(take.skeleton(), &two)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("target rig") && e.contains("pelvis"), "{e}");
+}
+
+#[test]
+fn real_takes_played_by_cmu_and_mixamo_rigs_keep_their_bones_and_come_back() {
+    let Some(data) = shared_data() else {
+        eprintln!("../shared/data is absent: skipped");
+        return;
+    };
+    let takes = [
+        "bandai/dataset-1/dataset-1_walk_proud_001.bvh",
+        "bandai/dataset-1/dataset-1_bow_old_001.bvh",
+        "bandai/dataset-2/dataset-2_run_active_001.bvh",
+    ];
+    let rigs = [
+        "dme_example_crlf_leadingdot_frametime.bvh",
+        "bvhpython_test_freebvh.bvh",
+        "bvhanim_test_mocapbank.bvh",
+    ];
+    for name in takes {
+        let take = read_bvh(&data.join(name)).unwrap();
+        for rig in rigs {
+            let other = read_bvh(&data.join("parser-cases").join(rig)).unwrap();
+            let there = Retargeting::detect(take.skeleton(), other.skeleton()).unwrap();
+            let moved = there.apply(&take).unwrap();
+            assert_eq!(moved.skeleton(), other.skeleton());
+            assert_eq!(moved.frame_count(), take.frame_count());
+            let angle = worst_bone_angle(&take, &moved);
+            assert!(
+                angle < 0.1,
+                "{name} on {rig}: a limb bone turned by {angle} deg"
+            );
+            // The pelvis follows the source's, scaled.
+            let (ps, pt) = (forward_kinematics(&take), forward_kinematics(&moved));
+            let (ms, mt) = (
+                BodyMap::detect(take.skeleton()).unwrap(),
+                BodyMap::detect(moved.skeleton()).unwrap(),
+            );
+            let pelvis = |m: &BodyMap| m.joint(BodyPart::Pelvis).unwrap();
+            for f in 0..take.frame_count() {
+                let wanted = there.scale() * ps.position(f, pelvis(&ms));
+                let d = wanted.distance(pt.position(f, pelvis(&mt)));
+                assert!(
+                    d < 1e-3 * there.scale() * 100.0,
+                    "{name} on {rig}, frame {f}: pelvis {d} off"
+                );
+            }
+            // And back: only the shoulder points move (by a clavicle's
+            // length difference), the arms with them.
+            let back = Retargeting::detect(other.skeleton(), take.skeleton())
+                .unwrap()
+                .apply(&moved)
+                .unwrap();
+            assert!(worst_bone_angle(&take, &back) < 0.1);
+            let (d, joint) = worst_joint_distance(&take, &back);
+            assert!(d < 3.0, "{name} via {rig}: {joint} came back {d} cm off");
+        }
+    }
+}
