@@ -564,3 +564,84 @@ fn unusable_inputs_are_refused_naming_the_file() {
     );
     assert!(!output.exists());
 }
+
+#[test]
+fn style_clips_and_sources_of_other_rigs_are_retargeted() {
+    let (Some(mixamo), Some(cmu), Some(two_joints)) = (
+        mocap_testdata::shared("parser-cases/bvhpython_test_freebvh.bvh"),
+        mocap_testdata::shared("parser-cases/dme_example_crlf_leadingdot_frametime.bvh"),
+        mocap_testdata::shared("parser-cases/bvhanim_test_simple.bvh"),
+    ) else {
+        eprintln!("../shared/data is absent: skipped");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (normal, proud) = (
+        sample("dataset-1_walk_normal_001.bvh"),
+        sample("dataset-1_walk_proud_001.bvh"),
+    );
+    // The proud walk played by a Mixamo rig (`mocap convert --retarget-to`).
+    let proud_mixamo = dir.path().join("proud-mixamo.bvh");
+    let out = mocap(&[
+        "convert",
+        &proud,
+        "--retarget-to",
+        path(&mixamo),
+        path(&proud_mixamo),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rig = read_bvh(&mixamo).unwrap();
+    assert_eq!(read_bvh(&proud_mixamo).unwrap().skeleton(), rig.skeleton());
+
+    // As a style clip: retargeted onto the source's rig, and said so.
+    let output = dir.path().join("out.bvh");
+    let apply = |source: &str, style: &str| {
+        mocap(&[
+            "style",
+            "apply",
+            source,
+            "--style",
+            style,
+            "-o",
+            path(&output),
+            "--json",
+        ])
+    };
+    let out = apply(&normal, path(&proud_mixamo));
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let notes = report["retargeted"].as_array().unwrap();
+    assert!(
+        notes.len() == 1 && notes[0].as_str().unwrap().contains("proud-mixamo.bvh"),
+        "{notes:?}"
+    );
+    let source = read_bvh(Path::new(&normal)).unwrap();
+    let restyled = read_bvh(&output).unwrap();
+    assert_eq!(
+        restyled.skeleton().joints().len(),
+        source.skeleton().joints().len()
+    );
+    // Same style as the clip on its own rig: the proud walk's slower stride.
+    let scale = report["time_scale"].as_f64().unwrap();
+    assert!(scale > 1.1, "time scale {scale}");
+
+    // A source of a CMU-style rig: played by the style clip's rig, restyled,
+    // and written on its own rig.
+    let out = apply(path(&cmu), &proud);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        read_bvh(&output).unwrap().skeleton(),
+        read_bvh(&cmu).unwrap().skeleton()
+    );
+
+    // A clip whose body parts cannot be found is refused, naming it.
+    std::fs::remove_file(&output).unwrap();
+    let out = apply(&normal, path(&two_joints));
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("bvhanim_test_simple.bvh") && stderr(&out).contains("body parts"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!output.exists());
+}

@@ -10,18 +10,26 @@
 //! origin, i.e. the ground of the capture). With `root_from_feet` the
 //! horizontal path is instead carried by the output's own planted feet, so
 //! they do not slide ([`crate::contact`]). A style clip must be of the same
-//! rig as the source (same joint names and hierarchy; other bone lengths are
-//! fine); another rig is refused with a message that names the differences:
-//! retargeting between rigs is not done here.
+//! rig as the model (same joint names and hierarchy; other bone lengths are
+//! fine). [`apply`] retargets clips of other rigs
+//! ([`mocap_core::retarget`], body parts matched by joint name): a style
+//! clip of another rig is played by the source's rig first; a source of
+//! another rig is played by the style clip's rig (when that one is the
+//! model's), restyled there, and the output played back by the source's own
+//! rig, so the output keeps the source's skeleton. A clip whose body parts
+//! cannot be found is refused with a message naming it.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use mocap_core::bodymap::BodyMap;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::io::write_motion;
 use mocap_core::ops::resample_fps;
+use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::Vec3;
 use mocap_core::Motion;
+use mocap_core::Skeleton;
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -304,6 +312,10 @@ pub struct ApplyReport {
     pub load_seconds: f64,
     /// Seconds writing the output.
     pub write_seconds: f64,
+    /// The clips that were of another rig than the model's, and what was
+    /// done with them.
+    #[serde(default)]
+    pub retargeted: Vec<String>,
 }
 
 /// Loads the model of `options` (or the default one).
@@ -314,6 +326,18 @@ pub fn load_model(model: Option<&Path>, device: DeviceChoice) -> Result<StyleMod
     }
 }
 
+/// A retargeting between two rigs whose body parts are found by name; the
+/// error says which rig's parts are missing ("this clip's", "the model's").
+fn retargeting(from: &Skeleton, to: &Skeleton) -> mocap_core::Result<Retargeting> {
+    let found = |skeleton: &Skeleton, whose: &str| {
+        BodyMap::detect(skeleton)
+            .map_err(|e| mocap_core::Error::Invalid(format!("{whose} body parts: {e}")))
+    };
+    let from_map = found(from, "this clip's")?;
+    let to_map = found(to, "the model rig's")?;
+    Retargeting::new(from, &from_map, to, &to_map)
+}
+
 /// Restyles a file and writes the result (see the module docs).
 pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
     let t = Instant::now();
@@ -322,6 +346,56 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
     let style = read_bvh(&options.style)?;
     let blend = match &options.blend {
         Some((path, w)) => Some((read_bvh(path)?, *w, path)),
+        None => None,
+    };
+    // The rig the restyle runs on: the source's when it is the model's,
+    // else the style clip's when that one is (the output is retargeted back).
+    let rig = &model.description.rig;
+    let fits = |m: &Motion| rig.check_skeleton(m.skeleton(), "").is_ok();
+    let mut retargeted = Vec::new();
+    let (source_on_rig, back) = if fits(&source) {
+        (source.clone(), None)
+    } else if fits(&style) {
+        let name = options.source.display();
+        let cannot = |e| {
+            invalid(format!(
+                "{name}: another rig than the model's, not retargeted: {e}"
+            ))
+        };
+        let there = retargeting(source.skeleton(), style.skeleton()).map_err(cannot)?;
+        let back = retargeting(style.skeleton(), source.skeleton()).map_err(cannot)?;
+        let there = there.apply(&source).map_err(cannot)?;
+        retargeted.push(format!(
+            "{name}: another rig than the model's: played by the style clip's rig, restyled, \
+             and played back by its own rig"
+        ));
+        (there, Some(back))
+    } else {
+        // Neither is of the model's rig: the rig check's message.
+        rig.check_skeleton(source.skeleton(), &options.source.display().to_string())?;
+        unreachable!("the source's rig was found not to fit")
+    };
+    // Style clips of other rigs are played by the rig the restyle runs on.
+    let mut onto_rig = |clip: Motion, path: &Path| -> Result<Motion> {
+        if fits(&clip) {
+            return Ok(clip);
+        }
+        let name = path.display();
+        let moved = retargeting(clip.skeleton(), source_on_rig.skeleton())
+            .and_then(|r| r.apply(&clip))
+            .map_err(|e| {
+                invalid(format!(
+                    "{name}: another rig than the model's, not retargeted: {e}"
+                ))
+            })?;
+        retargeted.push(format!(
+            "{name}: another rig than the model's: retargeted onto the source's rig"
+        ));
+        Ok(moved)
+    };
+    let style = onto_rig(style, &options.style)?;
+    let blend = match blend {
+        Some((motion, w, path)) => Some((onto_rig(motion, path)?, w, path)),
         None => None,
     };
     let load_seconds = t.elapsed().as_secs_f64();
@@ -378,14 +452,13 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         foot_contacts: options.foot_contacts,
         ..ConvertOptions::default()
     };
-    // Check the source's rig first so its message names the source file.
-    model
-        .description
-        .rig
-        .check_skeleton(source.skeleton(), &options.source.display().to_string())?;
-    let restyled = restyle(&model, &source, &styles, &convert_options, timings)?;
+    let restyled = restyle(&model, &source_on_rig, &styles, &convert_options, timings)?;
+    let output = match &back {
+        Some(back) => back.apply(&restyled.motion)?,
+        None => restyled.motion.clone(),
+    };
     let t = Instant::now();
-    write_motion(&options.out, &restyled.motion)?;
+    write_motion(&options.out, &output)?;
     let write_seconds = t.elapsed().as_secs_f64();
     let main: Vec<_> = restyled
         .conversion
@@ -421,11 +494,11 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         root_from_feet: options.root_from_feet,
         foot_contacts: options.foot_contacts,
         source_frames: source.frame_count(),
-        output_frames: restyled.motion.frame_count(),
-        fps: restyled.motion.fps(),
-        time_scale: restyled.motion.duration() / source.duration(),
-        distance_ratio: (travelled(&restyled.motion, &model.description.rig)
-            / travelled(&source, &model.description.rig)) as f64,
+        output_frames: output.frame_count(),
+        fps: output.fps(),
+        time_scale: output.duration() / source.duration(),
+        // Measured on the model's rig (before any retargeting back).
+        distance_ratio: (travelled(&restyled.motion, rig) / travelled(&source_on_rig, rig)) as f64,
         mean_patch_stretch,
         mean_similarity: if sims.is_empty() {
             f64::NAN
@@ -435,6 +508,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         timings: restyled.timings,
         load_seconds,
         write_seconds,
+        retargeted,
     })
 }
 

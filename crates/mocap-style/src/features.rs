@@ -133,9 +133,9 @@ impl RigLayout {
                 .collect();
             return Err(invalid(format!(
                 "{what}: another rig ({} joints{}{}{}); style transfer needs the same joint \
-                 names and hierarchy ({} joints starting {}); retargeting between rigs is not \
-                 supported: retarget the clip first, or train a model on this rig with \
-                 `mocap style train`",
+                 names and hierarchy ({} joints starting {}): play the clip on the model's rig \
+                 first (`mocap convert CLIP --retarget-to A_CLIP_OF_THAT_RIG.bvh OUT.bvh`), or \
+                 train a model on this rig with `mocap style train`",
                 names.len(),
                 if missing.is_empty() {
                     String::new()

@@ -238,6 +238,9 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else if !options.quiet {
+                for note in &report.retargeted {
+                    eprintln!("note: {note}");
+                }
                 eprintln!(
                     "wrote {} ({} frames from {}; time scale {:.2}, distance ratio {:.2})",
                     report.out.display(),
