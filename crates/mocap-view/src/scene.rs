@@ -494,14 +494,18 @@ fn figure_extent(positions: &[Vec3], parents: &[Option<usize>], bones: &[bool]) 
 
 /// Metres per length unit of a human figure whose first frame spans
 /// `extent` units (the diagonal of its bounding box, 1 to 2.5 m for an
-/// adult): metres, centimetres (Bandai, and ASF as read by `mocap_core`) or
-/// millimetres. Inches (60 to 100 for an adult) fall in the centimetre range
-/// and are taken as centimetres: the figure is then drawn 2.5 times too
-/// small but whole. An extent outside every range keeps the file's unit.
+/// adult): metres, the units of the CMU data converted to BVH (1/0.45 inch,
+/// 5.64 cm: its ASF files say `length 0.45`; an adult spans 25 to 45 with
+/// arms and legs apart),
+/// centimetres (Bandai, and ASF as read by `mocap_core`) or millimetres.
+/// Inches (60 to 100 for an adult) fall in the centimetre range and are
+/// taken as centimetres: the figure is then drawn 2.5 times too small but
+/// whole. An extent outside every range keeps the file's unit.
 pub fn guess_metres_per_unit(extent: f32) -> f32 {
     match extent {
         e if (0.3..=4.0).contains(&e) => 1.0,
-        e if (30.0..=400.0).contains(&e) => 0.01,
+        e if (8.0..50.0).contains(&e) => 0.0254 / 0.45,
+        e if (50.0..=400.0).contains(&e) => 0.01,
         e if (300.0..=4000.0).contains(&e) => 0.001,
         _ => 1.0,
     }

@@ -159,6 +159,9 @@ fn units_are_guessed_from_the_figure_size() {
     assert_eq!(guess_metres_per_unit(1.8), 1.0);
     assert_eq!(guess_metres_per_unit(175.0), 0.01);
     assert_eq!(guess_metres_per_unit(1750.0), 0.001);
+    // CMU takes converted to BVH: 1/0.45 inch (the CMU-style parser case
+    // spans 26 units in its first frame, a 1.4 m figure).
+    assert!((guess_metres_per_unit(26.0) - 0.056444).abs() < 1e-5);
     // Nothing human-sized: keep the numbers as they are.
     assert_eq!(guess_metres_per_unit(0.01), 1.0);
     assert_eq!(guess_metres_per_unit(1.0e6), 1.0);
