@@ -11,4 +11,12 @@ P=../shared/data/parser-cases
       $P/dme_example_crlf_leadingdot_frametime.bvh $P/bvhpython_test_freebvh.bvh $P/bvhanim_test_mocapbank.bvh
     echo
   done
+  echo "## Foreign clips on the Bandai rig"
+  echo
+  cat bench/retarget-plausibility.md
+  B=../shared/data/bandai
+  ./target/release/examples/retarget_check --plausibility samples/dataset-1_walk_normal_001.bvh \
+    $B/dataset-1/dataset-1_walk_proud_001.bvh $B/dataset-1/dataset-1_walk_old_001.bvh \
+    $B/dataset-2/dataset-2_walk_active_001.bvh $B/dataset-1/dataset-1_run_normal_001.bvh \
+    $P/dme_example_crlf_leadingdot_frametime.bvh $P/bvhpython_test_freebvh.bvh $P/bvhanim_test_mocapbank.bvh
 } > bench/results/retarget.md

@@ -15,6 +15,7 @@
 //! | chest | upper (thoracic) spine joint the shoulder girdle hangs from | `Chest` | `Spine2`, `Spine1` | `thorax` | `SpineShoulder` |
 //! | neck | base of the neck | `Neck` | `Neck1`, `Neck` | `lowerneck` | `Neck` |
 //! | head | head joint (top of the neck) | `Head` | `Head` | `head` | `Head` |
+//! | clavicle | inner end of the collarbone, where the shoulder girdle starts | `Shoulder_L` | `LeftShoulder` | `lclavicle` | - |
 //! | shoulder | glenohumeral joint, where the upper arm starts (not the clavicle) | `UpperArm_L` | `LeftArm` | `lhumerus` | `ShoulderLeft` |
 //! | elbow | elbow | `LowerArm_L` | `LeftForeArm` | `lradius` | `ElbowLeft` |
 //! | wrist | wrist, where the hand starts | `Hand_L` | `LeftHand` | `lwrist` | `WristLeft` |
@@ -71,6 +72,7 @@ pub enum BodyPart {
     Chest,
     Neck,
     Head,
+    LeftClavicle,
     LeftShoulder,
     LeftElbow,
     LeftWrist,
@@ -79,6 +81,7 @@ pub enum BodyPart {
     LeftKnee,
     LeftAnkle,
     LeftToe,
+    RightClavicle,
     RightShoulder,
     RightElbow,
     RightWrist,
@@ -91,12 +94,13 @@ pub enum BodyPart {
 
 impl BodyPart {
     /// Every part, in declaration order.
-    pub const ALL: [BodyPart; 21] = [
+    pub const ALL: [BodyPart; 23] = [
         BodyPart::Pelvis,
         BodyPart::Spine,
         BodyPart::Chest,
         BodyPart::Neck,
         BodyPart::Head,
+        BodyPart::LeftClavicle,
         BodyPart::LeftShoulder,
         BodyPart::LeftElbow,
         BodyPart::LeftWrist,
@@ -105,6 +109,7 @@ impl BodyPart {
         BodyPart::LeftKnee,
         BodyPart::LeftAnkle,
         BodyPart::LeftToe,
+        BodyPart::RightClavicle,
         BodyPart::RightShoulder,
         BodyPart::RightElbow,
         BodyPart::RightWrist,
@@ -116,17 +121,20 @@ impl BodyPart {
     ];
 
     /// Number of parts.
-    pub const COUNT: usize = 21;
+    pub const COUNT: usize = 23;
 
     /// Parts every built-in rig has; [`BodyMap::detect`] fails without them.
-    /// The others (spine, chest, neck, hands, toes) are missing from some
-    /// real rigs (Bandai has no joint beyond the wrist, Kinect no chest).
+    /// The others (spine, chest, neck, clavicles, hands, toes) are missing
+    /// from some real rigs (Bandai has no joint beyond the wrist, Kinect no
+    /// chest and no clavicles).
     pub fn is_required(self) -> bool {
         !matches!(
             self,
             BodyPart::Spine
                 | BodyPart::Chest
                 | BodyPart::Neck
+                | BodyPart::LeftClavicle
+                | BodyPart::RightClavicle
                 | BodyPart::LeftHand
                 | BodyPart::RightHand
                 | BodyPart::LeftToe
@@ -147,6 +155,7 @@ impl BodyPart {
             BodyPart::Chest => "chest",
             BodyPart::Neck => "neck",
             BodyPart::Head => "head",
+            BodyPart::LeftClavicle => "left_clavicle",
             BodyPart::LeftShoulder => "left_shoulder",
             BodyPart::LeftElbow => "left_elbow",
             BodyPart::LeftWrist => "left_wrist",
@@ -155,6 +164,7 @@ impl BodyPart {
             BodyPart::LeftKnee => "left_knee",
             BodyPart::LeftAnkle => "left_ankle",
             BodyPart::LeftToe => "left_toe",
+            BodyPart::RightClavicle => "right_clavicle",
             BodyPart::RightShoulder => "right_shoulder",
             BodyPart::RightElbow => "right_elbow",
             BodyPart::RightWrist => "right_wrist",
@@ -175,7 +185,7 @@ impl BodyPart {
     pub fn side(self) -> Option<Side> {
         match self.index() {
             0..=4 => None,
-            5..=12 => Some(Side::Left),
+            5..=13 => Some(Side::Left),
             _ => Some(Side::Right),
         }
     }
@@ -184,8 +194,8 @@ impl BodyPart {
     pub fn mirror(self) -> BodyPart {
         match self.side() {
             None => self,
-            Some(Side::Left) => BodyPart::ALL[self.index() + 8],
-            Some(Side::Right) => BodyPart::ALL[self.index() - 8],
+            Some(Side::Left) => BodyPart::ALL[self.index() + 9],
+            Some(Side::Right) => BodyPart::ALL[self.index() - 9],
         }
     }
 }
@@ -214,6 +224,7 @@ const BANDAI: Rig = Rig {
         (BodyPart::Neck, &["Neck"]),
         (BodyPart::Head, &["Head"]),
         // `Shoulder_L` is the clavicle; the upper arm starts at `UpperArm_L`.
+        (BodyPart::LeftClavicle, &["Shoulder_L"]),
         (BodyPart::LeftShoulder, &["UpperArm_L"]),
         (BodyPart::LeftElbow, &["LowerArm_L"]),
         (BodyPart::LeftWrist, &["Hand_L"]),
@@ -235,6 +246,7 @@ const CMU_BVH: Rig = Rig {
         // `Neck1` is the base of the neck.
         (BodyPart::Neck, &["Neck1", "Neck"]),
         (BodyPart::Head, &["Head"]),
+        (BodyPart::LeftClavicle, &["LeftShoulder"]),
         (BodyPart::LeftShoulder, &["LeftArm"]),
         (BodyPart::LeftElbow, &["LeftForeArm"]),
         (BodyPart::LeftWrist, &["LeftHand"]),
@@ -258,6 +270,7 @@ const ASF: Rig = Rig {
         (BodyPart::Chest, &["thorax"]),
         (BodyPart::Neck, &["lowerneck"]),
         (BodyPart::Head, &["head"]),
+        (BodyPart::LeftClavicle, &["lclavicle"]),
         (BodyPart::LeftShoulder, &["lhumerus"]),
         (BodyPart::LeftElbow, &["lradius"]),
         (BodyPart::LeftWrist, &["lwrist"]),
@@ -298,6 +311,7 @@ const BIOVISION: Rig = Rig {
         (BodyPart::Chest, &["Chest2", "Chest"]),
         (BodyPart::Neck, &["Neck"]),
         (BodyPart::Head, &["Head"]),
+        (BodyPart::LeftClavicle, &["LeftCollar"]),
         (BodyPart::LeftShoulder, &["LeftShoulder"]),
         (BodyPart::LeftElbow, &["LeftElbow"]),
         (BodyPart::LeftWrist, &["LeftWrist"]),

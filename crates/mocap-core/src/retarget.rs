@@ -3,47 +3,56 @@
 //!
 //! The two rigs are matched by their [`BodyMap`]s. A body part both rigs
 //! have is *mapped*; its joint on the target takes the global rotation of
-//! the source's joint, corrected for how the two rest poses differ:
+//! the source's joint, corrected for how the two rigs' joint axes differ:
 //!
 //! ```text
-//! G_t(j_t, f) = G_s(j_s, f) F_s(p) F_t(p)^-1                           (1)
+//! G_t(j_t, f) = G_s(j_s, f) R_s(j_s)^-1 F_s(p) F_t(p)^-1 R_t(j_t)         (1)
 //! ```
 //!
-//! where `G` are global rotations (forward kinematics) and `F(p)` is the
-//! *rest frame* of part `p` on each rig: its bone's direction at rest (from
-//! the part's joint to the next part down the chain, e.g. shoulder to elbow,
-//! measured between joint positions so that joints in between do not
-//! matter) and, for the twist about it, a body axis of the rest pose (the
-//! forward axis, or the left-right axis where the bone points forward, as a
-//! foot does; the pelvis and the chest use the left-right axis of the hips
-//! and of the shoulders, taken where the way to them leaves the joint, e.g.
-//! at the clavicles' start, which turns with the chest alone). At the
-//! source's rest pose (1) puts the target in
-//! the source's rest pose, bone for bone, whatever each rig's own rest pose
-//! is (a T-pose, an A-pose, or Bandai's, whose bones all lie along x). Parts
-//! with no part below them (head, hands, toes, or a wrist where one rig has
-//! no hand) borrow the rest-frame correction of the part above them.
+//! where `G` are global rotations (forward kinematics), `R` the global
+//! rotations of each rig in a *reference pose*, and `F(p)` the frame of part
+//! `p` in that pose: its bone's direction (from the part's joint to the next
+//! part down the chain, e.g. shoulder to elbow, measured between joint
+//! positions so that joints in between do not matter) and, for the twist
+//! about it, a body axis of the pose (the forward axis, or the left-right
+//! axis where the bone points forward, as a foot does; the pelvis and the
+//! chest use the left-right axis of the hips and of the shoulders, taken
+//! where the way to them leaves the joint, e.g. at the clavicles' start,
+//! which turns with the chest alone). `R^-1 F` is the part's frame in its
+//! joint's own axes, so (1) gives the target's bone the source's bone frame:
+//! bones keep their directions whatever the rigs' joint axes.
+//!
+//! The reference pose of a rig is the first frame of a motion of it
+//! ([`Retargeting::new`]): the frames `F` are only comparable between poses
+//! where limbs twist alike, which natural poses (standing, walking, a
+//! T-pose) do. The rest pose (every rotation zero, [`Motion::rest`]) is one
+//! only for rigs built so: CMU's and Mixamo's rest in a T-pose, but
+//! Bandai's rest has every bone along x, legs included, and local rotations
+//! retargeted with it are valid but turned far from any Bandai capture
+//! (bench/results/retarget.md). A retargeting there and back with the same
+//! two references gives the motion back exactly. Parts with no part below
+//! them (head, hands, toes, or a wrist where one rig has no hand) borrow the
+//! frame correction `F_s F_t^-1` of the part above them.
 //!
 //! Target joints of no part keep their rest rotation relative to their
-//! parent, except a joint between two mapped parts (a clavicle between the
-//! chest and the shoulder point, CMU's `LHipJoint` between the pelvis and
-//! the hip): it is turned so that the next mapped joint below it lands
-//! where the source has it relative to the mapped joint above (scaled), so
-//! shoulders keep their width and height. Joints above the pelvis keep
-//! their rest rotation; the root's translation puts the pelvis where the
-//! source's is, scaled by the ratio of the rigs' leg lengths (hip to knee to
-//! ankle at rest), so strides fit the new legs and the floor stays at the
-//! height it was.
+//! parent, except a joint between two mapped parts (CMU's `LHipJoint`
+//! between the pelvis and the hip, a clavicle where the source has none):
+//! it is turned so that the next mapped joint below it lands where the
+//! source has it relative to the mapped joint above (scaled). Joints above
+//! the pelvis keep their rest rotation; the pelvis is put where the source's
+//! is, scaled by the ratio of the rigs' leg lengths (hip to knee to ankle),
+//! so strides fit the new legs and the floor stays at the height it was.
 //!
 //! Both rigs are taken to be in the same world frame (the same up axis and
 //! units of their own). What is lost: motion of joints the source has and
 //! the target has no part for (fingers, extra spine joints are folded into
-//! the mapped ones), and twist where the rigs' rest poses disagree about it.
+//! the mapped ones), and twist where the reference poses disagree about it.
 
 use crate::bodymap::{BodyMap, BodyPart};
 use crate::error::{Error, Result};
 use crate::kinematics::forward_kinematics;
 use crate::motion::Motion;
+use crate::ops::trim;
 use crate::rotation::{Mat3, Quat, Vec3};
 use crate::skeleton::Skeleton;
 
@@ -89,6 +98,8 @@ fn bone_candidates(part: BodyPart) -> &'static [BodyPart] {
         Spine => &[Chest, Neck, Head],
         Chest => &[Neck, Head],
         Neck => &[Head],
+        LeftClavicle => &[LeftShoulder],
+        RightClavicle => &[RightShoulder],
         LeftShoulder => &[LeftElbow],
         LeftElbow => &[LeftWrist],
         LeftWrist => &[LeftHand],
@@ -114,7 +125,9 @@ fn part_above(part: BodyPart) -> Option<BodyPart> {
         Chest => Spine,
         Neck => Chest,
         Head => Neck,
-        LeftShoulder | RightShoulder => Chest,
+        LeftClavicle | RightClavicle => Chest,
+        LeftShoulder => LeftClavicle,
+        RightShoulder => RightClavicle,
         LeftElbow => LeftShoulder,
         LeftWrist => LeftElbow,
         LeftHand => LeftWrist,
@@ -131,11 +144,14 @@ fn part_above(part: BodyPart) -> Option<BodyPart> {
     })
 }
 
-/// One rig at rest: joint positions and the body's axes.
+/// One rig in its reference pose: joint positions and rotations, and the
+/// body's axes.
 struct RestRig<'a> {
     skeleton: &'a Skeleton,
     map: &'a BodyMap,
     positions: Vec<Vec3>,
+    /// Global joint rotations in the reference pose.
+    rotations: Vec<Quat>,
     /// From the right hip to the left, as seen from the pelvis joint.
     lateral: Vec3,
     /// From the right shoulder to the left, as seen from the chest joint.
@@ -144,13 +160,20 @@ struct RestRig<'a> {
 }
 
 impl<'a> RestRig<'a> {
-    fn new(skeleton: &'a Skeleton, map: &'a BodyMap, what: &str) -> Result<RestRig<'a>> {
-        let rest = Motion::rest(skeleton.clone(), 1.0, 1)?;
-        let positions = forward_kinematics(&rest).frame_positions(0).to_vec();
+    fn new(reference: &'a Motion, map: &'a BodyMap, what: &str) -> Result<RestRig<'a>> {
+        let skeleton = reference.skeleton();
+        if reference.frame_count() == 0 {
+            return Err(Error::Invalid(format!(
+                "the {what} rig's reference motion has no frame"
+            )));
+        }
+        let first = trim(reference, 0..1)?;
+        let poses = forward_kinematics(&first);
         let mut rig = RestRig {
             skeleton,
             map,
-            positions,
+            positions: poses.frame_positions(0).to_vec(),
+            rotations: poses.frame_rotations(0).to_vec(),
             lateral: Vec3::ZERO,
             shoulders: None,
             forward: Vec3::ZERO,
@@ -182,6 +205,30 @@ impl<'a> RestRig<'a> {
             .joint(BodyPart::Chest)
             .and_then(|chest| rig.across(chest, BodyPart::LeftShoulder, BodyPart::RightShoulder));
         Ok(rig)
+    }
+
+    /// The frame `F(p)` of (1) of a part whose bone (to the next part) is
+    /// `bone`: for the pelvis and the chest, the bone with the left-right
+    /// axis of the hips or the shoulders; for the other parts, the body's
+    /// axes (left-right, up, forward) turned by the smallest rotation that
+    /// takes the part's anatomical direction in a T-pose (up for the spine
+    /// and neck, sideways for a clavicle and an arm, down for a leg,
+    /// forward for a foot) onto its bone: its twist follows the body's the
+    /// way a limb's does when it is raised or swung from the T-pose.
+    fn part_frame(&self, part: BodyPart, bone: Vec3) -> Quat {
+        use BodyPart::*;
+        let up = self.forward.cross(self.lateral).normalize();
+        let body = Quat::from_mat3(&Mat3::from_cols(self.lateral, up, self.forward)).normalize();
+        let anatomical = match part {
+            Pelvis => return frame(bone, self.lateral),
+            Chest => return frame(bone, self.shoulders.unwrap_or(self.lateral)),
+            Spine | Neck | Head => up,
+            LeftClavicle | LeftShoulder | LeftElbow | LeftWrist | LeftHand => self.lateral,
+            RightClavicle | RightShoulder | RightElbow | RightWrist | RightHand => -self.lateral,
+            LeftHip | LeftKnee | RightHip | RightKnee => -up,
+            LeftAnkle | LeftToe | RightAnkle | RightToe => self.forward,
+        };
+        Quat::from_rotation_arc(anatomical, bone.normalize()) * body
     }
 
     fn position(&self, part: BodyPart) -> Option<Vec3> {
@@ -230,17 +277,21 @@ fn frame(direction: Vec3, secondary: Vec3) -> Quat {
 }
 
 impl Retargeting {
-    /// Prepares retargeting from `source` to `target`, located by their body
-    /// maps. Fails when the rigs share no bone to match (a required part of
-    /// [`BodyMap::detect`] missing from a hand-made map).
+    /// Prepares retargeting from the rig of `source_reference` to the rig of
+    /// `target_reference`, located by their body maps; the first frame of
+    /// each is its rig's reference pose `F` of (1) is measured in (give
+    /// `Motion::rest` for the rest pose; see the module docs on choosing).
+    /// Fails when a rig's body axes cannot be told or a reference has no
+    /// frame.
     pub fn new(
-        source: &Skeleton,
+        source_reference: &Motion,
         source_map: &BodyMap,
-        target: &Skeleton,
+        target_reference: &Motion,
         target_map: &BodyMap,
     ) -> Result<Retargeting> {
-        let rest_s = RestRig::new(source, source_map, "source")?;
-        let rest_t = RestRig::new(target, target_map, "target")?;
+        let (source, target) = (source_reference.skeleton(), target_reference.skeleton());
+        let rest_s = RestRig::new(source_reference, source_map, "source")?;
+        let rest_t = RestRig::new(target_reference, target_map, "target")?;
         let both = |p: BodyPart| source_map.joint(p).is_some() && target_map.joint(p).is_some();
         let leg = |rig: &RestRig| -> Result<f32> {
             let mut sum = 0.0;
@@ -263,8 +314,8 @@ impl Retargeting {
                 "a rig's legs have no length at rest: cannot scale between the rigs".into(),
             ));
         }
-        // Rest-frame corrections F_s F_t^-1 of (1), parts in order so that a
-        // part without a bone finds its parent's.
+        // Reference-frame corrections F_s F_t^-1 of (1) in world axes,
+        // parts in order so that a part without a bone finds its parent's.
         let mut corrections: [Option<Quat>; BodyPart::COUNT] = [None; BodyPart::COUNT];
         for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
             let below = bone_candidates(part).iter().copied().find(|&p| both(p));
@@ -278,18 +329,8 @@ impl Retargeting {
                     if bone_s.length() < 1e-6 || bone_t.length() < 1e-6 {
                         None
                     } else {
-                        // The forward axis fixes the twist, unless the
-                        // bone points (nearly) forward on either rig.
-                        let along_forward = bone_s.normalize().dot(rest_s.forward).abs() >= 0.8
-                            || bone_t.normalize().dot(rest_t.forward).abs() >= 0.8;
-                        let secondary = |rig: &RestRig| match part {
-                            BodyPart::Pelvis => rig.lateral,
-                            BodyPart::Chest => rig.shoulders.unwrap_or(rig.lateral),
-                            _ if along_forward => rig.lateral,
-                            _ => rig.forward,
-                        };
-                        let f_s = frame(bone_s, secondary(&rest_s));
-                        let f_t = frame(bone_t, secondary(&rest_t));
+                        let f_s = rest_s.part_frame(part, bone_s);
+                        let f_t = rest_t.part_frame(part, bone_t);
                         Some(f_s * f_t.inverse())
                     }
                 }
@@ -312,8 +353,10 @@ impl Retargeting {
         let mut counterpart = vec![None; n];
         for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
             let (j_t, j_s) = (target_map.joint(part), source_map.joint(part));
-            if let (Some(j_t), Some(j_s), Some(correction)) = (j_t, j_s, corrections[part.index()])
-            {
+            if let (Some(j_t), Some(j_s), Some(world)) = (j_t, j_s, corrections[part.index()]) {
+                // In the joints' own axes (their reference rotations undone).
+                let correction =
+                    (rest_s.rotations[j_s].inverse() * world * rest_t.rotations[j_t]).normalize();
                 roles[j_t] = Role::Mapped {
                     source: j_s,
                     correction,
@@ -362,14 +405,14 @@ impl Retargeting {
         })
     }
 
-    /// Prepares retargeting between two rigs whose body maps the built-in
-    /// rig tables find ([`BodyMap::detect`]).
-    pub fn detect(source: &Skeleton, target: &Skeleton) -> Result<Retargeting> {
-        let source_map =
-            BodyMap::detect(source).map_err(|e| Error::Invalid(format!("the source rig: {e}")))?;
-        let target_map =
-            BodyMap::detect(target).map_err(|e| Error::Invalid(format!("the target rig: {e}")))?;
-        Retargeting::new(source, &source_map, target, &target_map)
+    /// [`Retargeting::new`] for two rigs whose body maps the built-in rig
+    /// tables find ([`BodyMap::detect`]).
+    pub fn detect(source_reference: &Motion, target_reference: &Motion) -> Result<Retargeting> {
+        let source_map = BodyMap::detect(source_reference.skeleton())
+            .map_err(|e| Error::Invalid(format!("the source rig: {e}")))?;
+        let target_map = BodyMap::detect(target_reference.skeleton())
+            .map_err(|e| Error::Invalid(format!("the target rig: {e}")))?;
+        Retargeting::new(source_reference, &source_map, target_reference, &target_map)
     }
 
     /// Target leg length over source leg length: how root translations are

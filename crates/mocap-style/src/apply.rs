@@ -328,13 +328,13 @@ pub fn load_model(model: Option<&Path>, device: DeviceChoice) -> Result<StyleMod
 
 /// A retargeting between two rigs whose body parts are found by name; the
 /// error says which rig's parts are missing ("this clip's", "the model's").
-fn retargeting(from: &Skeleton, to: &Skeleton) -> mocap_core::Result<Retargeting> {
+fn retargeting(from: &Motion, to: &Motion) -> mocap_core::Result<Retargeting> {
     let found = |skeleton: &Skeleton, whose: &str| {
         BodyMap::detect(skeleton)
             .map_err(|e| mocap_core::Error::Invalid(format!("{whose} body parts: {e}")))
     };
-    let from_map = found(from, "this clip's")?;
-    let to_map = found(to, "the model rig's")?;
+    let from_map = found(from.skeleton(), "this clip's")?;
+    let to_map = found(to.skeleton(), "the model rig's")?;
     Retargeting::new(from, &from_map, to, &to_map)
 }
 
@@ -362,8 +362,8 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
                 "{name}: another rig than the model's, not retargeted: {e}"
             ))
         };
-        let there = retargeting(source.skeleton(), style.skeleton()).map_err(cannot)?;
-        let back = retargeting(style.skeleton(), source.skeleton()).map_err(cannot)?;
+        let there = retargeting(&source, &style).map_err(cannot)?;
+        let back = retargeting(&style, &source).map_err(cannot)?;
         let there = there.apply(&source).map_err(cannot)?;
         retargeted.push(format!(
             "{name}: another rig than the model's: played by the style clip's rig, restyled, \
@@ -381,7 +381,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
             return Ok(clip);
         }
         let name = path.display();
-        let moved = retargeting(clip.skeleton(), source_on_rig.skeleton())
+        let moved = retargeting(&clip, &source_on_rig)
             .and_then(|r| r.apply(&clip))
             .map_err(|e| {
                 invalid(format!(

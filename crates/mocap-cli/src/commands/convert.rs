@@ -29,9 +29,9 @@ pub struct Args {
     /// Keep frames A..B (0-based, B excluded; `A..` to the end).
     #[arg(long, value_name = "A..B")]
     frames: Option<String>,
-    /// Play the motion on the rig of this BVH file (its hierarchy and offsets; its frames are
-    /// not read): body parts matched by joint name, bone directions kept, strides scaled by
-    /// the legs' lengths.
+    /// Play the motion on the rig of this BVH file: body parts matched by joint name, bone
+    /// directions kept, strides scaled by the legs' lengths. The first frames of the input and
+    /// of this file are the two rigs' reference poses (best both standing or both T-poses).
     #[arg(long, value_name = "RIG.bvh")]
     retarget_to: Option<PathBuf>,
 }
@@ -84,7 +84,7 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
     }
     if let Some(rig) = &args.retarget_to {
         let target = io::bvh::read_bvh(rig)?;
-        motion = Retargeting::detect(motion.skeleton(), target.skeleton())
+        motion = Retargeting::detect(&motion, &target)
             .and_then(|r| r.apply(&motion))
             .with_context(|| format!("retargeting onto the rig of {}", rig.display()))?;
     }
