@@ -19,44 +19,10 @@ use std::time::Instant;
 use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::io::find_bvh_files;
+use mocap_core::metrics::largest_bone_angle_degrees;
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, Quat};
 use mocap_core::{forward_kinematics, Motion};
-
-const LIMBS: [(BodyPart, BodyPart); 10] = [
-    (BodyPart::LeftShoulder, BodyPart::LeftElbow),
-    (BodyPart::LeftElbow, BodyPart::LeftWrist),
-    (BodyPart::RightShoulder, BodyPart::RightElbow),
-    (BodyPart::RightElbow, BodyPart::RightWrist),
-    (BodyPart::LeftHip, BodyPart::LeftKnee),
-    (BodyPart::LeftKnee, BodyPart::LeftAnkle),
-    (BodyPart::RightHip, BodyPart::RightKnee),
-    (BodyPart::RightKnee, BodyPart::RightAnkle),
-    (BodyPart::LeftAnkle, BodyPart::LeftToe),
-    (BodyPart::RightAnkle, BodyPart::RightToe),
-];
-
-fn worst_limb_angle(a: &Motion, b: &Motion) -> f32 {
-    let (ma, mb) = (
-        BodyMap::detect(a.skeleton()).unwrap(),
-        BodyMap::detect(b.skeleton()).unwrap(),
-    );
-    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
-    let mut worst = 0.0f32;
-    for f in 0..a.frame_count() {
-        for (u, l) in LIMBS {
-            let (Some(ua), Some(la), Some(ub), Some(lb)) =
-                (ma.joint(u), ma.joint(l), mb.joint(u), mb.joint(l))
-            else {
-                continue;
-            };
-            let da = (pa.position(f, la) - pa.position(f, ua)).normalize();
-            let db = (pb.position(f, lb) - pb.position(f, ub)).normalize();
-            worst = worst.max(da.angle_between(db).to_degrees());
-        }
-    }
-    worst
-}
 
 /// The mean of a joint's local rotations over a motion.
 fn mean_local_rotation(motion: &Motion, joint: usize) -> Quat {
@@ -182,7 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let returned = back.apply(&moved)?;
             seconds += t.elapsed().as_secs_f64();
             scale = there.scale();
-            angle = angle.max(worst_limb_angle(take, &moved));
+            angle = angle.max(largest_bone_angle_degrees(take, &moved)?);
             let per_joint = mocap_core::metrics::joint_rotation_errors_degrees(take, &returned)?;
             rotation_sums.resize(per_joint.len(), 0.0);
             for (sum, e) in rotation_sums.iter_mut().zip(&per_joint) {

@@ -1,6 +1,6 @@
 //! The numbers every capability reports, computed in one place: joint
-//! position and rotation errors, acceleration error, jitter and bone-length
-//! statistics.
+//! position and rotation errors, acceleration error, jitter, bone-length
+//! statistics, and bone directions compared across rigs.
 //!
 //! Conventions:
 //! - Positions are compared as given (no root alignment, no Procrustes):
@@ -13,8 +13,9 @@
 //! - Two inputs of different shapes (joint or frame counts) give an error,
 //!   never a panic or a silently truncated comparison.
 
+use crate::bodymap::{BodyMap, BodyPart};
 use crate::error::{Error, Result};
-use crate::kinematics::GlobalPoses;
+use crate::kinematics::{forward_kinematics, GlobalPoses};
 use crate::motion::Motion;
 use crate::rotation::{angle_between, Vec3};
 use crate::skeleton::Skeleton;
@@ -249,4 +250,55 @@ fn nonempty(frames: usize, needed: usize, what: &str) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// The limb bones compared by [`largest_bone_angle_degrees`], as (the part
+/// the bone starts at, the part it ends at).
+pub const LIMB_BONES: [(BodyPart, BodyPart); 11] = [
+    (BodyPart::LeftShoulder, BodyPart::LeftElbow),
+    (BodyPart::LeftElbow, BodyPart::LeftWrist),
+    (BodyPart::RightShoulder, BodyPart::RightElbow),
+    (BodyPart::RightElbow, BodyPart::RightWrist),
+    (BodyPart::LeftHip, BodyPart::LeftKnee),
+    (BodyPart::LeftKnee, BodyPart::LeftAnkle),
+    (BodyPart::RightHip, BodyPart::RightKnee),
+    (BodyPart::RightKnee, BodyPart::RightAnkle),
+    (BodyPart::LeftAnkle, BodyPart::LeftToe),
+    (BodyPart::RightAnkle, BodyPart::RightToe),
+    (BodyPart::Neck, BodyPart::Head),
+];
+
+/// The largest angle (degrees), over all frames and the [`LIMB_BONES`] both
+/// rigs have, between the direction of a bone in `a` and the same bone in
+/// `b`: two motions of possibly different rigs (located by
+/// [`BodyMap::detect`]) with the same number of frames. What retargeting
+/// should keep.
+pub fn largest_bone_angle_degrees(a: &Motion, b: &Motion) -> Result<f32> {
+    if a.frame_count() != b.frame_count() {
+        return Err(Error::Invalid(format!(
+            "comparing bones of motions of {} and {} frames",
+            a.frame_count(),
+            b.frame_count()
+        )));
+    }
+    let (map_a, map_b) = (
+        BodyMap::detect(a.skeleton())?,
+        BodyMap::detect(b.skeleton())?,
+    );
+    let (poses_a, poses_b) = (forward_kinematics(a), forward_kinematics(b));
+    let direction = |poses: &GlobalPoses, map: &BodyMap, f, (from, to): (BodyPart, BodyPart)| {
+        Some((poses.position(f, map.joint(to)?) - poses.position(f, map.joint(from)?)).normalize())
+    };
+    let mut largest = 0.0f32;
+    for f in 0..a.frame_count() {
+        for bone in LIMB_BONES {
+            if let (Some(x), Some(y)) = (
+                direction(&poses_a, &map_a, f, bone),
+                direction(&poses_b, &map_b, f, bone),
+            ) {
+                largest = largest.max(x.angle_between(y).to_degrees());
+            }
+        }
+    }
+    Ok(largest)
 }

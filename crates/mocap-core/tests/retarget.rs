@@ -6,47 +6,15 @@ use mocap_testdata::{sample_walk, shared_data};
 
 use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::io::bvh::read_bvh;
-use mocap_core::metrics::joint_rotation_errors_degrees;
+use mocap_core::metrics::{joint_rotation_errors_degrees, largest_bone_angle_degrees};
 use mocap_core::ops::scale;
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{Quat, Vec3};
-use mocap_core::{forward_kinematics, GlobalPoses, Joint, Motion, Skeleton};
+use mocap_core::{forward_kinematics, Joint, Motion, Skeleton};
 
-/// The limb bones, as (upper part, lower part).
-const BONES: [(BodyPart, BodyPart); 11] = [
-    (BodyPart::LeftShoulder, BodyPart::LeftElbow),
-    (BodyPart::LeftElbow, BodyPart::LeftWrist),
-    (BodyPart::RightShoulder, BodyPart::RightElbow),
-    (BodyPart::RightElbow, BodyPart::RightWrist),
-    (BodyPart::LeftHip, BodyPart::LeftKnee),
-    (BodyPart::LeftKnee, BodyPart::LeftAnkle),
-    (BodyPart::RightHip, BodyPart::RightKnee),
-    (BodyPart::RightKnee, BodyPart::RightAnkle),
-    (BodyPart::LeftAnkle, BodyPart::LeftToe),
-    (BodyPart::RightAnkle, BodyPart::RightToe),
-    (BodyPart::Neck, BodyPart::Head),
-];
-
-/// Largest angle (degrees) between the same limb bone of two motions, over
-/// all frames and the bones both rigs have.
+/// Largest angle (degrees) between the same limb bone of two motions.
 fn worst_bone_angle(a: &Motion, b: &Motion) -> f32 {
-    let (ma, mb) = (
-        BodyMap::detect(a.skeleton()).unwrap(),
-        BodyMap::detect(b.skeleton()).unwrap(),
-    );
-    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
-    let bone = |p: &GlobalPoses, m: &BodyMap, f, (u, l): (BodyPart, BodyPart)| {
-        Some((p.position(f, m.joint(l)?) - p.position(f, m.joint(u)?)).normalize())
-    };
-    let mut worst = 0.0f32;
-    for f in 0..a.frame_count() {
-        for b in BONES {
-            if let (Some(x), Some(y)) = (bone(&pa, &ma, f, b), bone(&pb, &mb, f, b)) {
-                worst = worst.max(x.angle_between(y).to_degrees());
-            }
-        }
-    }
-    worst
+    largest_bone_angle_degrees(a, b).unwrap()
 }
 
 /// Largest distance between the same joint of two motions of one rig, and
