@@ -159,8 +159,10 @@ impl CleanModel {
         if c != self.description.network.channels {
             return Err(CleanError::Invalid(format!(
                 "the model was trained on a rig of {} joints with rotations ({}, ...), this take \
-                 has {} ({c} features against {}): clean it with --filter, or train a model on \
-                 this rig with `mocap clean train`",
+                 has {} ({c} features against {}): clean it with --filter butterworth-gcv:2, or \
+                 train a model on this rig with `mocap clean train` (played by the model's rig \
+                 through retargeting, takes of other rigs came out worse than with that filter: \
+                 bench/results/clean.md, \"Takes of other rigs\")",
                 self.description.joints.len(),
                 self.description.joints[..self.description.joints.len().min(3)].join(", "),
                 layout.joints.len(),

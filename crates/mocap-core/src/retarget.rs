@@ -429,6 +429,26 @@ impl Retargeting {
     /// `motion` (of the source rig) played by the target rig, at the same
     /// frame rate.
     pub fn apply(&self, motion: &Motion) -> Result<Motion> {
+        self.play(motion, None)
+    }
+
+    /// `motion` (of the source rig) played onto `onto`, a motion of the
+    /// target rig with as many frames: the mapped joints take `motion`'s
+    /// rotations, every other joint keeps its local rotation in `onto`, and
+    /// the translations are `onto`'s. What changing a take through another
+    /// rig needs (e.g. a denoiser of another rig: its output played back
+    /// onto the take keeps the joints it does not know as they were).
+    pub fn apply_onto(&self, motion: &Motion, onto: &Motion) -> Result<Motion> {
+        if onto.skeleton() != &self.target || onto.frame_count() != motion.frame_count() {
+            return Err(Error::Invalid(format!(
+                "apply_onto: a motion of the target rig with {} frames is needed",
+                motion.frame_count()
+            )));
+        }
+        self.play(motion, Some(onto))
+    }
+
+    fn play(&self, motion: &Motion, onto: Option<&Motion>) -> Result<Motion> {
         let skeleton = motion.skeleton();
         if skeleton.joint_count() != self.source.joint_count()
             || skeleton
@@ -443,7 +463,10 @@ impl Retargeting {
         }
         let frames = motion.frame_count();
         let source = forward_kinematics(motion);
-        let mut out = Motion::rest(self.target.clone(), motion.frame_time(), frames)?;
+        let mut out = match onto {
+            Some(onto) => onto.clone(),
+            None => Motion::rest(self.target.clone(), motion.frame_time(), frames)?,
+        };
         let n = self.target.joint_count();
         let (pelvis_t, pelvis_s) = self.pelvis;
         let mut rotations = vec![Quat::IDENTITY; n];
@@ -458,6 +481,9 @@ impl Retargeting {
                 let translation = out.local_translation(f, j);
                 positions[j] = parent_position + parent_rotation * translation;
                 let global = match self.roles[j] {
+                    _ if onto.is_some() && !matches!(self.roles[j], Role::Mapped { .. }) => {
+                        parent_rotation * out.local_rotation(f, j)
+                    }
                     Role::Rest => parent_rotation,
                     Role::Mapped {
                         source: s,
@@ -496,6 +522,9 @@ impl Retargeting {
                 out.set_local_rotation(f, j, parent_rotation.inverse() * global);
                 // What the channels hold (a joint may lack rotation channels).
                 rotations[j] = parent_rotation * out.local_rotation(f, j);
+            }
+            if onto.is_some() {
+                continue;
             }
             // The pelvis goes where the source's is: by its own position
             // channels where it has them (Bandai's rig keeps its root still

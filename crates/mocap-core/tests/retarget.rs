@@ -190,3 +190,39 @@ fn real_takes_played_by_cmu_and_mixamo_rigs_keep_their_bones_and_come_back() {
         }
     }
 }
+
+#[test]
+fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
+    let Some(data) = shared_data() else {
+        eprintln!("../shared/data is absent: skipped");
+        return;
+    };
+    let bandai = read_bvh(&sample_walk()).unwrap();
+    for rig in [
+        "dme_example_crlf_leadingdot_frametime.bvh",
+        "bvhpython_test_freebvh.bvh",
+    ] {
+        let take = read_bvh(&data.join("parser-cases").join(rig)).unwrap();
+        let on_bandai = Retargeting::detect(&take, &bandai)
+            .unwrap()
+            .apply(&take)
+            .unwrap();
+        let back = Retargeting::detect(&bandai, &take).unwrap();
+        // Played back onto the take: the joints Bandai's rig lacks (fingers,
+        // CMU's extra spine and hip joints) keep their own rotations.
+        let restored = back.apply_onto(&on_bandai, &take).unwrap();
+        let (d, joint) = worst_joint_distance(&take, &restored);
+        assert!(d < 1e-3 * 30.0, "{rig}: {joint} moved by {d}");
+        let errors = joint_rotation_errors_degrees(&take, &restored).unwrap();
+        for (j, e) in errors.iter().enumerate() {
+            let name = &take.skeleton().joint(j).name;
+            assert!(*e < 0.05, "{rig}: {name} turned by {e} deg");
+        }
+        // Played back alone, those joints are at rest or aimed instead.
+        let alone = back.apply(&on_bandai).unwrap();
+        let errors = joint_rotation_errors_degrees(&take, &alone).unwrap();
+        assert!(errors.iter().any(|&e| e > 1.0), "{rig}: {errors:?}");
+        // The motion to play onto must be of the target rig, frame for frame.
+        assert!(back.apply_onto(&on_bandai, &bandai).is_err());
+    }
+}
