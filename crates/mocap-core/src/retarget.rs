@@ -59,10 +59,11 @@ use crate::skeleton::Skeleton;
 /// What a target joint does during retargeting.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Role {
-    /// Keeps its rest rotation relative to its parent.
+    /// Keeps its rest rotation relative to its parent (with
+    /// [`Retargeting::apply_onto`], its rotation in the motion played onto).
     Rest,
     /// Takes the global rotation of source joint `source`, times `correction`
-    /// (`F_s F_t^-1` of (1)).
+    /// (`R_s^-1 F_s F_t^-1 R_t` of (1)).
     Mapped { source: usize, correction: Quat },
     /// Turned so that target joint `below` lands where source joint
     /// `source_below` is relative to `source_above`, target joint `above`
@@ -89,8 +90,8 @@ pub struct Retargeting {
     scale: f32,
 }
 
-/// The next part down the chain from `part` whose bone direction gives the
-/// part's rest frame (the first of the candidates both rigs have).
+/// The next part down the chain from `part` whose direction gives the
+/// part's bone in its frame `F` (the first of the candidates both rigs have).
 fn bone_candidates(part: BodyPart) -> &'static [BodyPart] {
     use BodyPart::*;
     match part {
@@ -146,7 +147,7 @@ fn part_above(part: BodyPart) -> Option<BodyPart> {
 
 /// One rig in its reference pose: joint positions and rotations, and the
 /// body's axes.
-struct RestRig<'a> {
+struct ReferenceRig<'a> {
     skeleton: &'a Skeleton,
     map: &'a BodyMap,
     positions: Vec<Vec3>,
@@ -159,8 +160,8 @@ struct RestRig<'a> {
     forward: Vec3,
 }
 
-impl<'a> RestRig<'a> {
-    fn new(reference: &'a Motion, map: &'a BodyMap, what: &str) -> Result<RestRig<'a>> {
+impl<'a> ReferenceRig<'a> {
+    fn new(reference: &'a Motion, map: &'a BodyMap, what: &str) -> Result<ReferenceRig<'a>> {
         let skeleton = reference.skeleton();
         if reference.frame_count() == 0 {
             return Err(Error::Invalid(format!(
@@ -169,7 +170,7 @@ impl<'a> RestRig<'a> {
         }
         let first = trim(reference, 0..1)?;
         let poses = forward_kinematics(&first);
-        let mut rig = RestRig {
+        let mut rig = ReferenceRig {
             skeleton,
             map,
             positions: poses.frame_positions(0).to_vec(),
@@ -254,7 +255,7 @@ impl<'a> RestRig<'a> {
     }
 
     /// From part `right` to part `left` as seen from joint `from` (see
-    /// [`RestRig::toward`]), if both parts exist and lie apart.
+    /// [`ReferenceRig::toward`]), if both parts exist and lie apart.
     fn across(&self, from: usize, left: BodyPart, right: BodyPart) -> Option<Vec3> {
         let (l, r) = (self.map.joint(left)?, self.map.joint(right)?);
         let (a, b) = (self.toward(from, l), self.toward(from, r));
@@ -267,7 +268,7 @@ impl<'a> RestRig<'a> {
     }
 }
 
-/// The rest frame of a bone along `direction` with its twist fixed by
+/// The frame of a bone along `direction` with its twist fixed by
 /// `secondary` (columns: direction, `secondary` made perpendicular, their
 /// cross product).
 fn frame(direction: Vec3, secondary: Vec3) -> Quat {
@@ -290,10 +291,10 @@ impl Retargeting {
         target_map: &BodyMap,
     ) -> Result<Retargeting> {
         let (source, target) = (source_reference.skeleton(), target_reference.skeleton());
-        let rest_s = RestRig::new(source_reference, source_map, "source")?;
-        let rest_t = RestRig::new(target_reference, target_map, "target")?;
+        let reference_s = ReferenceRig::new(source_reference, source_map, "source")?;
+        let reference_t = ReferenceRig::new(target_reference, target_map, "target")?;
         let both = |p: BodyPart| source_map.joint(p).is_some() && target_map.joint(p).is_some();
-        let leg = |rig: &RestRig| -> Result<f32> {
+        let leg = |rig: &ReferenceRig| -> Result<f32> {
             let mut sum = 0.0;
             for [hip, knee, ankle] in [
                 [BodyPart::LeftHip, BodyPart::LeftKnee, BodyPart::LeftAnkle],
@@ -308,10 +309,10 @@ impl Retargeting {
             }
             Ok(sum / 2.0)
         };
-        let (leg_s, leg_t) = (leg(&rest_s)?, leg(&rest_t)?);
+        let (leg_s, leg_t) = (leg(&reference_s)?, leg(&reference_t)?);
         if !(leg_s > 0.0 && leg_t > 0.0) {
             return Err(Error::Invalid(
-                "a rig's legs have no length at rest: cannot scale between the rigs".into(),
+                "a rig's legs have no length: cannot scale between the rigs".into(),
             ));
         }
         // Reference-frame corrections F_s F_t^-1 of (1) in world axes,
@@ -321,16 +322,16 @@ impl Retargeting {
             let below = bone_candidates(part).iter().copied().find(|&p| both(p));
             let correction = match below {
                 Some(below) => {
-                    let bone = |rig: &RestRig| {
+                    let bone = |rig: &ReferenceRig| {
                         rig.position(below).unwrap_or_default()
                             - rig.position(part).unwrap_or_default()
                     };
-                    let (bone_s, bone_t) = (bone(&rest_s), bone(&rest_t));
+                    let (bone_s, bone_t) = (bone(&reference_s), bone(&reference_t));
                     if bone_s.length() < 1e-6 || bone_t.length() < 1e-6 {
                         None
                     } else {
-                        let f_s = rest_s.part_frame(part, bone_s);
-                        let f_t = rest_t.part_frame(part, bone_t);
+                        let f_s = reference_s.part_frame(part, bone_s);
+                        let f_t = reference_t.part_frame(part, bone_t);
                         Some(f_s * f_t.inverse())
                     }
                 }
@@ -356,7 +357,8 @@ impl Retargeting {
             if let (Some(j_t), Some(j_s), Some(world)) = (j_t, j_s, corrections[part.index()]) {
                 // In the joints' own axes (their reference rotations undone).
                 let correction =
-                    (rest_s.rotations[j_s].inverse() * world * rest_t.rotations[j_t]).normalize();
+                    (reference_s.rotations[j_s].inverse() * world * reference_t.rotations[j_t])
+                        .normalize();
                 roles[j_t] = Role::Mapped {
                     source: j_s,
                     correction,
