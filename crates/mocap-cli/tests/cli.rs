@@ -42,6 +42,12 @@ fn info_json_reports_the_sample() {
     assert_eq!(first["frame_time"], 0.0333333);
     let hi_y = first["bounding_box"][1][1].as_f64().unwrap();
     assert!((100.0..250.0).contains(&hi_y), "head height {hi_y} cm");
+    // Bandai's rig: every part but the hands beyond the wrists.
+    assert_eq!(first["rig"], "Bandai Namco");
+    let parts = first["body_parts"].as_array().unwrap();
+    assert_eq!(parts.len(), 21, "{parts:?}");
+    assert!(parts.contains(&serde_json::json!("left_clavicle")));
+    assert!(!parts.contains(&serde_json::json!("left_hand")));
 }
 
 #[test]

@@ -1,6 +1,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::io::MotionSource;
 use mocap_core::{forward_kinematics, Motion};
 use serde::Serialize;
@@ -32,11 +33,18 @@ struct Info {
     bounding_box: Option<[[f32; 3]; 2]>,
     root: String,
     joint_names: Vec<String>,
+    /// The built-in rig the body parts were found by, `None` when the
+    /// required parts are not found (retargeting and style transfer then
+    /// need a rig file).
+    rig: Option<String>,
+    /// The body parts found, by key (`pelvis`, `left_clavicle`...).
+    body_parts: Vec<String>,
 }
 
 fn describe(source: &MotionSource, motion: &Motion) -> Info {
     let skeleton = motion.skeleton();
     let poses = forward_kinematics(motion);
+    let map = BodyMap::detect(skeleton).ok();
     Info {
         file: source.display_name(),
         joints: skeleton.joint_count(),
@@ -55,6 +63,11 @@ fn describe(source: &MotionSource, motion: &Motion) -> Info {
             .map(|j| j.name.clone())
             .unwrap_or_default(),
         joint_names: skeleton.joints().iter().map(|j| j.name.clone()).collect(),
+        rig: map.as_ref().map(|m| m.rig().to_string()),
+        body_parts: map
+            .iter()
+            .flat_map(|m| m.parts().map(|(part, _)| part.key().to_string()))
+            .collect(),
     }
 }
 
@@ -91,6 +104,17 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 "  bounds     x {:.2}..{:.2}  y {:.2}..{:.2}  z {:.2}..{:.2}",
                 lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
             );
+        }
+        match &info.rig {
+            Some(rig) => println!(
+                "  rig        {rig} ({} of {} body parts)",
+                info.body_parts.len(),
+                BodyPart::COUNT
+            ),
+            None => println!(
+                "  rig        body parts not found (retargeting and restyling need a rig file: \
+                 see mocap_core::bodymap)"
+            ),
         }
     }
     Ok(())
