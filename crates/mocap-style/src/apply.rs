@@ -16,8 +16,9 @@
 //! clip of another rig is played by the source's rig first; a source of
 //! another rig is played by the style clip's rig (when that one is the
 //! model's), restyled there, and the output played back by the source's own
-//! rig, so the output keeps the source's skeleton. A clip whose body parts
-//! cannot be found is refused with a message naming it.
+//! rig, so the output keeps the source's skeleton (joints the model's rig
+//! has no part for, such as fingers, are then at rest). A clip whose body
+//! parts cannot be found is refused with a message naming it.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -326,15 +327,16 @@ pub fn load_model(model: Option<&Path>, device: DeviceChoice) -> Result<StyleMod
     }
 }
 
-/// A retargeting between two rigs whose body parts are found by name; the
-/// error says which rig's parts are missing ("this clip's", "the model's").
+/// A retargeting from the rig of `from` (the clip an error is about) to the
+/// rig of `to`, body parts found by name; the error says whose parts are
+/// missing.
 fn retargeting(from: &Motion, to: &Motion) -> mocap_core::Result<Retargeting> {
     let found = |skeleton: &Skeleton, whose: &str| {
         BodyMap::detect(skeleton)
             .map_err(|e| mocap_core::Error::Invalid(format!("{whose} body parts: {e}")))
     };
     let from_map = found(from.skeleton(), "this clip's")?;
-    let to_map = found(to.skeleton(), "the model rig's")?;
+    let to_map = found(to.skeleton(), "the other clip's")?;
     Retargeting::new(from, &from_map, to, &to_map)
 }
 
