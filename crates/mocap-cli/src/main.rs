@@ -51,6 +51,17 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let options = commands::GlobalOptions { quiet: cli.quiet };
+    // Batch commands end quietly when what reads their output stops reading
+    // (`mocap info x.bvh | head`), as Unix tools do, instead of panicking on
+    // the broken pipe. Not the servers (`view`, `fuse serve`, `fuse send`):
+    // a client that goes away must not stop them.
+    #[cfg(unix)]
+    if !matches!(cli.command, Command::View(_) | Command::Fuse(_)) {
+        // SAFETY: called once at start-up, before any other thread exists.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
+    }
     // The libraries' own progress bars (training) obey --quiet too.
     mocap_nn::train::hide_progress(cli.quiet);
     let result = match cli.command {

@@ -164,3 +164,31 @@ fn asf_amc_converts_to_a_bvh_with_the_same_poses() {
     let error = metrics::mean_joint_position_error(&original, &converted, None).unwrap();
     assert!(error < 1e-3, "mean joint position error {error} cm");
 }
+
+/// `mocap info ... | head`: the reader goes away; mocap ends quietly (on
+/// Unix, by SIGPIPE as `yes | head` does), never with a panic.
+#[cfg(unix)]
+#[test]
+fn output_to_a_closed_pipe_ends_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = dir.path().join("tiny.bvh");
+    std::fs::write(
+        &tiny,
+        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Xposition Yposition Zposition\n  \
+         End Site\n  {\n    OFFSET 0 1 0\n  }\n}\nMOTION\nFrames: 1\nFrame Time: 0.0333333\n0 0 0\n",
+    )
+    .unwrap();
+    // Far more output than a pipe holds, so writing must meet the closed end.
+    let files: Vec<&Path> = std::iter::repeat_n(tiny.as_path(), 3000).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .arg("info")
+        .args(&files)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+}

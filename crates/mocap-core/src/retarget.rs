@@ -163,12 +163,12 @@ struct ReferenceRig<'a> {
 impl<'a> ReferenceRig<'a> {
     fn new(reference: &'a Motion, map: &'a BodyMap, what: &str) -> Result<ReferenceRig<'a>> {
         let skeleton = reference.skeleton();
-        if reference.frame_count() == 0 {
-            return Err(Error::Invalid(format!(
-                "the {what} rig's reference motion has no frame"
-            )));
-        }
-        let first = trim(reference, 0..1)?;
+        // A rig file without frames: its rest pose.
+        let first = if reference.frame_count() == 0 {
+            Motion::rest(skeleton.clone(), reference.frame_time(), 1)?
+        } else {
+            trim(reference, 0..1)?
+        };
         let poses = forward_kinematics(&first);
         let mut rig = ReferenceRig {
             skeleton,
@@ -197,7 +197,7 @@ impl<'a> ReferenceRig<'a> {
         let up = (up - up.dot(rig.lateral) * rig.lateral).normalize_or_zero();
         if rig.lateral == Vec3::ZERO || up == Vec3::ZERO {
             return Err(Error::Invalid(format!(
-                "the {what} rig's rest pose has its hips at one point or its spine along the hips: \
+                "the {what} rig's reference pose has its hips at one point or its spine along the hips: \
                  cannot tell its body axes"
             )));
         }
@@ -280,10 +280,10 @@ fn frame(direction: Vec3, secondary: Vec3) -> Quat {
 impl Retargeting {
     /// Prepares retargeting from the rig of `source_reference` to the rig of
     /// `target_reference`, located by their body maps; the first frame of
-    /// each is its rig's reference pose `F` of (1) is measured in (give
-    /// `Motion::rest` for the rest pose; see the module docs on choosing).
-    /// Fails when a rig's body axes cannot be told or a reference has no
-    /// frame.
+    /// each is its rig's reference pose `F` of (1) is measured in (its rest
+    /// pose when it has no frame; give `Motion::rest` for the rest pose
+    /// anyway; see the module docs on choosing). Fails when a rig's body
+    /// axes cannot be told.
     pub fn new(
         source_reference: &Motion,
         source_map: &BodyMap,
