@@ -53,10 +53,12 @@ fn main() -> ExitCode {
     let options = commands::GlobalOptions { quiet: cli.quiet };
     // Batch commands end quietly when what reads their output stops reading
     // (`mocap info x.bvh | head`), as Unix tools do, instead of panicking on
-    // the broken pipe. Not the servers (`view`, `fuse serve`, `fuse send`):
-    // a client that goes away must not stop them.
+    // the broken pipe. Not the servers and senders (`view`, `fuse serve`,
+    // `fuse send`): a peer that goes away must not stop them.
     #[cfg(unix)]
-    if !matches!(cli.command, Command::View(_) | Command::Fuse(_)) {
+    if !matches!(&cli.command, Command::View(_))
+        && !matches!(&cli.command, Command::Fuse(args) if args.is_network())
+    {
         // SAFETY: called once at start-up, before any other thread exists.
         unsafe {
             libc::signal(libc::SIGPIPE, libc::SIG_DFL);

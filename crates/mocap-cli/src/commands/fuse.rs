@@ -33,6 +33,14 @@ pub struct Args {
     command: FuseCommand,
 }
 
+impl Args {
+    /// Whether this is the fusion server or a sender (long-running, on the
+    /// network), as opposed to a batch command.
+    pub fn is_network(&self) -> bool {
+        matches!(self.command, FuseCommand::Serve(_) | FuseCommand::Send(_))
+    }
+}
+
 #[derive(clap::Subcommand)]
 enum FuseCommand {
     /// Simulate Kinect v2 sensors watching a BVH take: their recordings, the true calibration, the measured person and room scans.
