@@ -30,7 +30,10 @@
 //! Bandai's rest has every bone along x, legs included, and local rotations
 //! retargeted with it are valid but turned far from any Bandai capture
 //! (bench/results/retarget.md). A retargeting there and back with the same
-//! two references gives the motion back exactly. Parts with no part below
+//! two references gives the motion back exactly. Two rigs with the same
+//! joints (names, hierarchy and bone directions; other bone lengths, as two
+//! performers of one capture setup) need no convention: every joint keeps
+//! its local rotation. Parts with no part below
 //! them (head, hands, toes, or a wrist where one rig has no hand) borrow the
 //! frame correction `F_s F_t^-1` of the part above them.
 //!
@@ -392,6 +395,38 @@ impl Retargeting {
                     above: a,
                     source_below: counterpart[b].expect("mapped"),
                     source_above: counterpart[a].expect("mapped"),
+                };
+            }
+        }
+        // The same joints with the same axes (another performer on one rig:
+        // names, hierarchy and the directions of the bones below the pelvis
+        // alike within 5 degrees, lengths free; where the pelvis hangs from a
+        // helper root is a placement, not a bone): every joint takes its
+        // counterpart's rotation as it is, with no reference-pose convention
+        // to turn a forearm where two first frames disagree.
+        let body = target.subtree(pelvis_t);
+        let same_axes = |j: usize| {
+            let (a, b) = (
+                source.joint(j).offset.normalize_or_zero(),
+                target.joint(j).offset.normalize_or_zero(),
+            );
+            j == pelvis_t
+                || !body.contains(&j)
+                || (a == Vec3::ZERO && b == Vec3::ZERO)
+                || a.dot(b) > 5.0f32.to_radians().cos()
+        };
+        let same_joints = source.joint_count() == n
+            && source
+                .joints()
+                .iter()
+                .zip(target.joints())
+                .all(|(a, b)| a.name == b.name && a.parent == b.parent)
+            && (0..n).all(same_axes);
+        if same_joints {
+            for (j, role) in roles.iter_mut().enumerate() {
+                *role = Role::Mapped {
+                    source: j,
+                    correction: Quat::IDENTITY,
                 };
             }
         }

@@ -226,3 +226,31 @@ fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
         assert!(back.apply_onto(&on_bandai, &bandai).is_err());
     }
 }
+
+#[test]
+fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
+    // Another performer of the same rig (half the size), its reference a
+    // different clip whose first frame is another pose.
+    let take = read_bvh(&sample_walk()).unwrap();
+    let other = scale(
+        &read_bvh(&mocap_testdata::sample("dataset-1_walk_proud_001.bvh")).unwrap(),
+        0.5,
+    );
+    let moved = Retargeting::detect(&take, &other)
+        .unwrap()
+        .apply(&take)
+        .unwrap();
+    assert_eq!(moved.skeleton(), other.skeleton());
+    let errors = joint_rotation_errors_degrees(&take, &moved).unwrap();
+    assert!(errors.iter().all(|&e| e < 0.01), "{errors:?}");
+    // Strides scale with the legs: the pelvis at half its path.
+    let (a, b) = (forward_kinematics(&take), forward_kinematics(&moved));
+    let pelvis = BodyMap::detect(take.skeleton())
+        .unwrap()
+        .require(BodyPart::Pelvis)
+        .unwrap();
+    for f in 0..take.frame_count() {
+        let d = (0.5 * a.position(f, pelvis)).distance(b.position(f, pelvis));
+        assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
+    }
+}
