@@ -42,7 +42,7 @@
 //! which would smear each spike's jumps over the frames around it and take
 //! part of it for noise (bench/results/clean.md).
 
-use mocap_core::rotation::{angle_between, slerp, Quat};
+use mocap_core::rotation::{angle_between, mean_of_close, slerp};
 use mocap_core::{forward_kinematics, Motion};
 use serde::{Deserialize, Serialize};
 
@@ -79,18 +79,6 @@ impl Default for DespikeOptions {
             global: true,
         }
     }
-}
-
-/// The mean of unit quaternions that lie close together (sign-aligned to
-/// the first, summed, normalised).
-fn mean_rotation(rotations: impl Iterator<Item = Quat>) -> Quat {
-    let mut sum = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
-    let mut first: Option<Quat> = None;
-    for q in rotations {
-        let reference = *first.get_or_insert(q);
-        sum += if q.dot(reference) < 0.0 { -q } else { q };
-    }
-    sum.normalize()
 }
 
 /// A spike that was found: `joint` and its subtree, frames
@@ -252,8 +240,8 @@ pub fn normalised_jumps(motion: &Motion, span: usize, global: bool) -> Vec<f32> 
     for k in (0..n).filter(|&k| skeleton.joint(k).has_rotation_channels()) {
         let mut angles: Vec<f32> = (first..=last)
             .map(|t| {
-                let before = mean_rotation((t - span..t).map(|f| rotation(f, k)));
-                let after = mean_rotation((t..t + span).map(|f| rotation(f, k)));
+                let before = mean_of_close((t - span..t).map(|f| rotation(f, k)));
+                let after = mean_of_close((t..t + span).map(|f| rotation(f, k)));
                 angle_between(before, after).to_degrees()
             })
             .collect();
@@ -321,6 +309,7 @@ mod tests {
     use super::*;
     use crate::noise::{add_spikes, Spike, SpikeNoise};
     use crate::test_support::{branching_motion, synthetic_motion_phase};
+    use mocap_core::rotation::Quat;
     use rand::SeedableRng;
 
     /// The branching test body with spikes from a shifted copy.

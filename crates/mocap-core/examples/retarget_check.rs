@@ -21,19 +21,8 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::io::find_bvh_files;
 use mocap_core::metrics::largest_bone_angle_degrees;
 use mocap_core::retarget::Retargeting;
-use mocap_core::rotation::{angle_between, Quat};
+use mocap_core::rotation::{angle_between, mean_of_close, Quat};
 use mocap_core::{forward_kinematics, Motion};
-
-/// The mean of a joint's local rotations over a motion.
-fn mean_local_rotation(motion: &Motion, joint: usize) -> Quat {
-    let first = motion.local_rotation(0, joint);
-    let mut sum = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
-    for f in 0..motion.frame_count() {
-        let q = motion.local_rotation(f, joint);
-        sum += if q.dot(first) < 0.0 { -q } else { q };
-    }
-    sum.normalize()
-}
 
 /// See the module docs (`--plausibility`).
 fn plausibility(reference: &Path, clips: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
@@ -46,7 +35,9 @@ fn plausibility(reference: &Path, clips: &[PathBuf]) -> Result<(), Box<dyn std::
         .collect();
     let means: Vec<Quat> = joints
         .iter()
-        .map(|&j| mean_local_rotation(&reference, j))
+        .map(|&j| {
+            mean_of_close((0..reference.frame_count()).map(|f| reference.local_rotation(f, j)))
+        })
         .collect();
     let rest = |m: &Motion| Motion::rest(m.skeleton().clone(), m.frame_time(), 1);
     println!("| clip | reference poses | mean angle to the reference's mean local rotations (deg) | largest joint's (deg) |");

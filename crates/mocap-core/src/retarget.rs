@@ -56,7 +56,7 @@ use crate::error::{Error, Result};
 use crate::kinematics::forward_kinematics;
 use crate::motion::Motion;
 use crate::ops::trim;
-use crate::rotation::{Mat3, Quat, Vec3};
+use crate::rotation::{frame_from_axes, Quat, Vec3};
 use crate::skeleton::Skeleton;
 
 /// What a target joint does during retargeting.
@@ -222,10 +222,10 @@ impl<'a> ReferenceRig<'a> {
     fn part_frame(&self, part: BodyPart, bone: Vec3) -> Quat {
         use BodyPart::*;
         let up = self.forward.cross(self.lateral).normalize();
-        let body = Quat::from_mat3(&Mat3::from_cols(self.lateral, up, self.forward)).normalize();
+        let body = frame_from_axes(self.lateral, up);
         let anatomical = match part {
-            Pelvis => return frame(bone, self.lateral),
-            Chest => return frame(bone, self.shoulders.unwrap_or(self.lateral)),
+            Pelvis => return frame_from_axes(bone, self.lateral),
+            Chest => return frame_from_axes(bone, self.shoulders.unwrap_or(self.lateral)),
             Spine | Neck | Head => up,
             LeftClavicle | LeftShoulder | LeftElbow | LeftWrist | LeftHand => self.lateral,
             RightClavicle | RightShoulder | RightElbow | RightWrist | RightHand => -self.lateral,
@@ -271,15 +271,6 @@ impl<'a> ReferenceRig<'a> {
     }
 }
 
-/// The frame of a bone along `direction` with its twist fixed by
-/// `secondary` (columns: direction, `secondary` made perpendicular, their
-/// cross product).
-fn frame(direction: Vec3, secondary: Vec3) -> Quat {
-    let x = direction.normalize();
-    let y = (secondary - secondary.dot(x) * x).normalize();
-    Quat::from_mat3(&Mat3::from_cols(x, y, x.cross(y))).normalize()
-}
-
 impl Retargeting {
     /// Prepares retargeting from the rig of `source_reference` to the rig of
     /// `target_reference`, located by their body maps; the first frame of
@@ -296,7 +287,6 @@ impl Retargeting {
         let (source, target) = (source_reference.skeleton(), target_reference.skeleton());
         let reference_s = ReferenceRig::new(source_reference, source_map, "source")?;
         let reference_t = ReferenceRig::new(target_reference, target_map, "target")?;
-        let both = |p: BodyPart| source_map.joint(p).is_some() && target_map.joint(p).is_some();
         let leg = |rig: &ReferenceRig| -> Result<f32> {
             let mut sum = 0.0;
             for [hip, knee, ankle] in [
@@ -318,93 +308,16 @@ impl Retargeting {
                 "a rig's legs have no length: cannot scale between the rigs".into(),
             ));
         }
-        // Reference-frame corrections F_s F_t^-1 of (1) in world axes,
-        // parts in order so that a part without a bone finds its parent's.
-        let mut corrections: [Option<Quat>; BodyPart::COUNT] = [None; BodyPart::COUNT];
-        for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
-            let below = bone_candidates(part).iter().copied().find(|&p| both(p));
-            let correction = match below {
-                Some(below) => {
-                    let bone = |rig: &ReferenceRig| {
-                        rig.position(below).unwrap_or_default()
-                            - rig.position(part).unwrap_or_default()
-                    };
-                    let (bone_s, bone_t) = (bone(&reference_s), bone(&reference_t));
-                    if bone_s.length() < 1e-6 || bone_t.length() < 1e-6 {
-                        None
-                    } else {
-                        let f_s = reference_s.part_frame(part, bone_s);
-                        let f_t = reference_t.part_frame(part, bone_t);
-                        Some(f_s * f_t.inverse())
-                    }
-                }
-                None => None,
-            };
-            corrections[part.index()] = correction.or_else(|| {
-                let mut above = part_above(part);
-                while let Some(a) = above {
-                    if let Some(c) = corrections[a.index()] {
-                        return Some(c);
-                    }
-                    above = part_above(a);
-                }
-                Some(Quat::IDENTITY)
-            });
-        }
         let n = target.joint_count();
-        let mut roles = vec![Role::Rest; n];
-        // Target joint -> source joint, for mapped parts.
-        let mut counterpart = vec![None; n];
-        for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
-            let (j_t, j_s) = (target_map.joint(part), source_map.joint(part));
-            if let (Some(j_t), Some(j_s), Some(world)) = (j_t, j_s, corrections[part.index()]) {
-                // In the joints' own axes (their reference rotations undone).
-                let correction =
-                    (reference_s.rotations[j_s].inverse() * world * reference_t.rotations[j_t])
-                        .normalize();
-                roles[j_t] = Role::Mapped {
-                    source: j_s,
-                    correction,
-                };
-                counterpart[j_t] = Some(j_s);
-            }
-        }
         let pelvis_t = target_map.require(BodyPart::Pelvis)?;
         let pelvis_s = source_map.require(BodyPart::Pelvis)?;
-        // Joints between two mapped ones are aimed at the one below.
-        for j in 0..n {
-            if counterpart[j].is_some() || !target.subtree(pelvis_t).contains(&j) {
-                continue;
-            }
-            let mut above = target.joint(j).parent;
-            while let Some(a) = above {
-                if counterpart[a].is_some() {
-                    break;
-                }
-                above = target.joint(a).parent;
-            }
-            // The nearest mapped joint below, breadth first.
-            let below = target
-                .subtree(j)
-                .into_iter()
-                .filter(|&k| counterpart[k].is_some())
-                .min_by_key(|&k| depth(target, k));
-            if let (Some(a), Some(b)) = (above, below) {
-                roles[j] = Role::Aimed {
-                    below: b,
-                    above: a,
-                    source_below: counterpart[b].expect("mapped"),
-                    source_above: counterpart[a].expect("mapped"),
-                };
-            }
-        }
+        let body = target.subtree(pelvis_t);
         // The same joints with the same axes (another performer on one rig:
         // names, hierarchy and the directions of the bones below the pelvis
         // alike within 5 degrees, lengths free; where the pelvis hangs from a
         // helper root is a placement, not a bone): every joint takes its
         // counterpart's rotation as it is, with no reference-pose convention
         // to turn a forearm where two first frames disagree.
-        let body = target.subtree(pelvis_t);
         let same_axes = |j: usize| {
             let (a, b) = (
                 source.joint(j).offset.normalize_or_zero(),
@@ -422,14 +335,16 @@ impl Retargeting {
                 .zip(target.joints())
                 .all(|(a, b)| a.name == b.name && a.parent == b.parent)
             && (0..n).all(same_axes);
-        if same_joints {
-            for (j, role) in roles.iter_mut().enumerate() {
-                *role = Role::Mapped {
+        let roles = if same_joints {
+            (0..n)
+                .map(|j| Role::Mapped {
                     source: j,
                     correction: Quat::IDENTITY,
-                };
-            }
-        }
+                })
+                .collect()
+        } else {
+            part_roles(&reference_s, &reference_t, &body)
+        };
         Ok(Retargeting {
             source: source.clone(),
             target: target.clone(),
@@ -456,11 +371,6 @@ impl Retargeting {
     /// scaled.
     pub fn scale(&self) -> f32 {
         self.scale
-    }
-
-    /// The target rig.
-    pub fn target(&self) -> &Skeleton {
-        &self.target
     }
 
     /// `motion` (of the source rig) played by the target rig, at the same
@@ -565,19 +475,113 @@ impl Retargeting {
             }
             // The pelvis goes where the source's is: by its own position
             // channels where it has them (Bandai's rig keeps its root still
-            // and moves the pelvis), else by the root's. Joints above the
-            // pelvis are at rest, so a shift of either is a shift in the world.
+            // and moves the pelvis), else by the root's; the world shift is
+            // taken into the axes of the moved joint's parent (turned when
+            // the joints above the pelvis are the source's own).
             let shift = self.scale * source.position(f, pelvis_s) - positions[pelvis_t];
             let moved = if self.target.joint(pelvis_t).has_position_channels() {
                 pelvis_t
             } else {
                 self.root
             };
+            let above = self
+                .target
+                .joint(moved)
+                .parent
+                .map_or(Quat::IDENTITY, |p| rotations[p]);
             let translation = out.local_translation(f, moved);
-            out.set_local_translation(f, moved, translation + shift);
+            out.set_local_translation(f, moved, translation + above.inverse() * shift);
         }
         Ok(out)
     }
+}
+
+/// The roles of the target's joints from the body parts both rigs have (see
+/// the module docs): mapped parts with their corrections of (1), joints
+/// between two mapped ones aimed, the others at rest. `body` lists the
+/// target's pelvis and the joints below it.
+fn part_roles(reference_s: &ReferenceRig, reference_t: &ReferenceRig, body: &[usize]) -> Vec<Role> {
+    let (source_map, target_map) = (reference_s.map, reference_t.map);
+    let target = reference_t.skeleton;
+    let n = target.joint_count();
+    let both = |p: BodyPart| source_map.joint(p).is_some() && target_map.joint(p).is_some();
+    // Reference-frame corrections F_s F_t^-1 of (1) in world axes,
+    // parts in order so that a part without a bone finds its parent's.
+    let mut corrections: [Option<Quat>; BodyPart::COUNT] = [None; BodyPart::COUNT];
+    for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
+        let below = bone_candidates(part).iter().copied().find(|&p| both(p));
+        let correction = match below {
+            Some(below) => {
+                let bone = |rig: &ReferenceRig| {
+                    rig.position(below).unwrap_or_default() - rig.position(part).unwrap_or_default()
+                };
+                let (bone_s, bone_t) = (bone(reference_s), bone(reference_t));
+                if bone_s.length() < 1e-6 || bone_t.length() < 1e-6 {
+                    None
+                } else {
+                    let f_s = reference_s.part_frame(part, bone_s);
+                    let f_t = reference_t.part_frame(part, bone_t);
+                    Some(f_s * f_t.inverse())
+                }
+            }
+            None => None,
+        };
+        corrections[part.index()] = correction.or_else(|| {
+            let mut above = part_above(part);
+            while let Some(a) = above {
+                if let Some(c) = corrections[a.index()] {
+                    return Some(c);
+                }
+                above = part_above(a);
+            }
+            Some(Quat::IDENTITY)
+        });
+    }
+    let mut roles = vec![Role::Rest; n];
+    // Target joint -> source joint, for mapped parts.
+    let mut counterpart = vec![None; n];
+    for part in BodyPart::ALL.into_iter().filter(|&p| both(p)) {
+        let (j_t, j_s) = (target_map.joint(part), source_map.joint(part));
+        if let (Some(j_t), Some(j_s), Some(world)) = (j_t, j_s, corrections[part.index()]) {
+            // In the joints' own axes (their reference rotations undone).
+            let correction =
+                (reference_s.rotations[j_s].inverse() * world * reference_t.rotations[j_t])
+                    .normalize();
+            roles[j_t] = Role::Mapped {
+                source: j_s,
+                correction,
+            };
+            counterpart[j_t] = Some(j_s);
+        }
+    }
+    // Joints between two mapped ones are aimed at the one below.
+    for j in 0..n {
+        if counterpart[j].is_some() || !body.contains(&j) {
+            continue;
+        }
+        let mut above = target.joint(j).parent;
+        while let Some(a) = above {
+            if counterpart[a].is_some() {
+                break;
+            }
+            above = target.joint(a).parent;
+        }
+        // The nearest mapped joint below, breadth first.
+        let below = target
+            .subtree(j)
+            .into_iter()
+            .filter(|&k| counterpart[k].is_some())
+            .min_by_key(|&k| depth(target, k));
+        if let (Some(a), Some(b)) = (above, below) {
+            roles[j] = Role::Aimed {
+                below: b,
+                above: a,
+                source_below: counterpart[b].expect("mapped"),
+                source_above: counterpart[a].expect("mapped"),
+            };
+        }
+    }
+    roles
 }
 
 /// Number of joints above `joint`.

@@ -244,16 +244,36 @@ pub fn quat_to_6d(q: Quat) -> [f32; 6] {
 }
 
 /// Quaternion of a (not necessarily orthonormal) 6D representation, by
-/// Gram-Schmidt on the two columns. A degenerate input gives the identity.
+/// Gram-Schmidt on the two columns ([`frame_from_axes`]). A degenerate input
+/// gives the identity.
 pub fn rot6d_to_quat(r: [f32; 6]) -> Quat {
-    let a1 = Vec3::new(r[0], r[1], r[2]);
-    let a2 = Vec3::new(r[3], r[4], r[5]);
-    let b1 = a1.normalize_or_zero();
-    let b2 = (a2 - b1 * b1.dot(a2)).normalize_or_zero();
+    frame_from_axes(Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]))
+}
+
+/// The rotation whose x axis points along `x` and whose y axis is `y` made
+/// perpendicular to it (Gram-Schmidt; z is their cross product): the frame
+/// of a bone along `x` with its twist fixed by `y`. The identity when `x` is
+/// zero or `y` is along it.
+pub fn frame_from_axes(x: Vec3, y: Vec3) -> Quat {
+    let b1 = x.normalize_or_zero();
+    let b2 = (y - b1 * b1.dot(y)).normalize_or_zero();
     if b1 == Vec3::ZERO || b2 == Vec3::ZERO {
         return Quat::IDENTITY;
     }
     Quat::from_mat3(&Mat3::from_cols(b1, b2, b1.cross(b2))).normalize()
+}
+
+/// The mean of unit quaternions that lie close together (each sign-aligned
+/// to the first, summed, normalised): good for the rotations of a joint over
+/// a few frames or a steady take, not for rotations far apart.
+pub fn mean_of_close(rotations: impl IntoIterator<Item = Quat>) -> Quat {
+    let mut sum = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+    let mut first: Option<Quat> = None;
+    for q in rotations {
+        let reference = *first.get_or_insert(q);
+        sum += if q.dot(reference) < 0.0 { -q } else { q };
+    }
+    sum.normalize()
 }
 
 /// Spherical linear interpolation along the shorter arc.

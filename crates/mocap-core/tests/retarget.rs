@@ -254,3 +254,29 @@ fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
         assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
     }
 }
+
+#[test]
+fn a_turned_helper_root_still_puts_the_pelvis_where_the_source_has_it() {
+    // The bundled walk with its helper root (`joint_Root`, above the pelvis)
+    // turned a quarter about the vertical: the same joints, so the root's
+    // rotation is carried; the pelvis must still follow the source's path.
+    let mut take = read_bvh(&sample_walk()).unwrap();
+    let turn = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    for f in 0..take.frame_count() {
+        take.set_local_rotation(f, 0, turn);
+    }
+    let small = scale(&take, 0.5);
+    let moved = Retargeting::detect(&take, &small)
+        .unwrap()
+        .apply(&take)
+        .unwrap();
+    let (a, b) = (forward_kinematics(&take), forward_kinematics(&moved));
+    let pelvis = BodyMap::detect(take.skeleton())
+        .unwrap()
+        .require(BodyPart::Pelvis)
+        .unwrap();
+    for f in 0..take.frame_count() {
+        let d = (0.5 * a.position(f, pelvis)).distance(b.position(f, pelvis));
+        assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
+    }
+}
