@@ -227,6 +227,20 @@ fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
     }
 }
 
+/// The pelvis of `moved` (a rig of half the size, the same joints) follows
+/// half the path of `take`'s, frame for frame.
+fn assert_pelvis_at_half(take: &Motion, moved: &Motion) {
+    let (a, b) = (forward_kinematics(take), forward_kinematics(moved));
+    let pelvis = BodyMap::detect(take.skeleton())
+        .unwrap()
+        .require(BodyPart::Pelvis)
+        .unwrap();
+    for f in 0..take.frame_count() {
+        let d = (0.5 * a.position(f, pelvis)).distance(b.position(f, pelvis));
+        assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
+    }
+}
+
 #[test]
 fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
     // Another performer of the same rig (half the size), its reference a
@@ -244,15 +258,7 @@ fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
     let errors = joint_rotation_errors_degrees(&take, &moved).unwrap();
     assert!(errors.iter().all(|&e| e < 0.01), "{errors:?}");
     // Strides scale with the legs: the pelvis at half its path.
-    let (a, b) = (forward_kinematics(&take), forward_kinematics(&moved));
-    let pelvis = BodyMap::detect(take.skeleton())
-        .unwrap()
-        .require(BodyPart::Pelvis)
-        .unwrap();
-    for f in 0..take.frame_count() {
-        let d = (0.5 * a.position(f, pelvis)).distance(b.position(f, pelvis));
-        assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
-    }
+    assert_pelvis_at_half(&take, &moved);
 }
 
 #[test]
@@ -270,13 +276,5 @@ fn a_turned_helper_root_still_puts_the_pelvis_where_the_source_has_it() {
         .unwrap()
         .apply(&take)
         .unwrap();
-    let (a, b) = (forward_kinematics(&take), forward_kinematics(&moved));
-    let pelvis = BodyMap::detect(take.skeleton())
-        .unwrap()
-        .require(BodyPart::Pelvis)
-        .unwrap();
-    for f in 0..take.frame_count() {
-        let d = (0.5 * a.position(f, pelvis)).distance(b.position(f, pelvis));
-        assert!(d < 0.05, "frame {f}: pelvis {d} cm off");
-    }
+    assert_pelvis_at_half(&take, &moved);
 }
