@@ -556,6 +556,28 @@ impl BodyMap {
         })
     }
 
+    /// Rest length of the legs, hip to knee to ankle, averaged over both
+    /// legs ([`Skeleton::chain_length`], in file units): the scale of strides
+    /// and root heights between performers and rigs.
+    pub fn leg_length(&self, skeleton: &Skeleton) -> Result<f32> {
+        let mut sum = 0.0;
+        for (hip, ankle) in [
+            (BodyPart::LeftHip, BodyPart::LeftAnkle),
+            (BodyPart::RightHip, BodyPart::RightAnkle),
+        ] {
+            let (hip, ankle) = (self.require(hip)?, self.require(ankle)?);
+            sum += skeleton.chain_length(ankle, hip).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "the {} rig's ankle `{}` is not below its hip `{}`",
+                    self.rig,
+                    skeleton.joint(ankle).name,
+                    skeleton.joint(hip).name
+                ))
+            })?;
+        }
+        Ok(sum / 2.0)
+    }
+
     /// The located parts and their joints, in [`BodyPart::ALL`] order.
     pub fn parts(&self) -> impl Iterator<Item = (BodyPart, usize)> + '_ {
         BodyPart::ALL

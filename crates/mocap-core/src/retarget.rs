@@ -287,22 +287,10 @@ impl Retargeting {
         let (source, target) = (source_reference.skeleton(), target_reference.skeleton());
         let reference_s = ReferenceRig::new(source_reference, source_map, "source")?;
         let reference_t = ReferenceRig::new(target_reference, target_map, "target")?;
-        let leg = |rig: &ReferenceRig| -> Result<f32> {
-            let mut sum = 0.0;
-            for [hip, knee, ankle] in [
-                [BodyPart::LeftHip, BodyPart::LeftKnee, BodyPart::LeftAnkle],
-                [
-                    BodyPart::RightHip,
-                    BodyPart::RightKnee,
-                    BodyPart::RightAnkle,
-                ],
-            ] {
-                let at = |p| rig.map.require(p).map(|j| rig.positions[j]);
-                sum += at(hip)?.distance(at(knee)?) + at(knee)?.distance(at(ankle)?);
-            }
-            Ok(sum / 2.0)
-        };
-        let (leg_s, leg_t) = (leg(&reference_s)?, leg(&reference_t)?);
+        let (leg_s, leg_t) = (
+            source_map.leg_length(source)?,
+            target_map.leg_length(target)?,
+        );
         if !(leg_s > 0.0 && leg_t > 0.0) {
             return Err(Error::Invalid(
                 "a rig's legs have no length: cannot scale between the rigs".into(),

@@ -276,6 +276,20 @@ impl Skeleton {
         out
     }
 
+    /// Rest length of the bone chain from `joint` up to its ancestor
+    /// `ancestor`: the sum of the offsets' lengths of `joint` and every joint
+    /// between them (not of `ancestor` itself). `None` when `ancestor` is not
+    /// above `joint`; 0 when they are the same joint.
+    pub fn chain_length(&self, joint: usize, ancestor: usize) -> Option<f32> {
+        let mut length = 0.0;
+        let mut at = joint;
+        while at != ancestor {
+            length += self.joints[at].offset.length();
+            at = self.joints[at].parent?;
+        }
+        Some(length)
+    }
+
     /// Consumes the skeleton and returns its joints (to edit and rebuild).
     pub fn into_joints(self) -> Vec<Joint> {
         self.joints

@@ -611,3 +611,30 @@ fn real_rigs_put_parts_at_their_anatomical_points() {
     check_anatomy(&m, "CMU/HDM05 ASF", "HDM_bd");
     assert_eq!(mirror_pairs(m.skeleton()).len(), 12);
 }
+
+#[test]
+fn leg_length_is_the_mean_of_both_legs_hip_to_ankle() {
+    // Unit offsets, except the shins: left 3, right 5 (and a long toe and
+    // hip offset, which are not part of the leg).
+    let mut joints = bandai().into_joints();
+    for joint in &mut joints {
+        joint.offset = match joint.name.as_str() {
+            "Foot_L" => Vec3::new(0.0, -3.0, 0.0),
+            "Foot_R" => Vec3::new(0.0, -5.0, 0.0),
+            "Toes_L" | "Toes_R" | "UpperLeg_L" | "UpperLeg_R" => Vec3::new(0.0, 0.0, 7.0),
+            _ => Vec3::new(0.0, -1.0, 0.0),
+        };
+    }
+    let skeleton = Skeleton::new(joints).unwrap();
+    let map = BodyMap::detect(&skeleton).unwrap();
+    // Thigh 1 plus shin 3 or 5.
+    assert_eq!(map.leg_length(&skeleton).unwrap(), 5.0);
+    let (hips, foot) = (
+        skeleton.find("Hips").unwrap(),
+        skeleton.find("Foot_L").unwrap(),
+    );
+    assert_eq!(skeleton.chain_length(foot, hips), Some(11.0));
+    assert_eq!(skeleton.chain_length(foot, foot), Some(0.0));
+    // The hips are not below the foot.
+    assert_eq!(skeleton.chain_length(hips, foot), None);
+}

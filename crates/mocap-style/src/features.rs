@@ -168,20 +168,12 @@ impl RigLayout {
         Ok(())
     }
 
-    /// Total rest length of the left leg (hip to ankle), in file units: the
-    /// scale of root heights between performers.
+    /// Rest length of the legs, hip to ankle, averaged over both legs
+    /// ([`Skeleton::chain_length`], file units): the scale of root heights
+    /// and strides between performers.
     pub fn leg_length(&self, skeleton: &Skeleton) -> f32 {
-        let ankle = self.left_foot[0];
-        let mut length = 0.0;
-        let mut j = ankle;
-        while j != self.left_hip {
-            length += skeleton.joint(j).offset.length();
-            match skeleton.joint(j).parent {
-                Some(p) => j = p,
-                None => break,
-            }
-        }
-        length
+        let leg = |ankle: usize, hip: usize| skeleton.chain_length(ankle, hip).unwrap_or(0.0);
+        (leg(self.left_foot[0], self.left_hip) + leg(self.right_foot[0], self.right_hip)) / 2.0
     }
 }
 
