@@ -8,7 +8,7 @@
 #                                          # on real clips (held out + cross-validation)
 #   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
 #   bash bench/style/run.sh --contacts # also patches with foot-contact cleanup and with
-#                                      # the root carried by the feet (both opt-in)
+#                                      # the root carried by the feet everywhere (both opt-in)
 # (flags combine)
 #
 # Build profile: `--profile test` (dependencies at opt-level 2 from the dev
@@ -57,17 +57,24 @@ if flag --classifiers; then
     --content-descriptor intervals "$DATA/dataset-2" > "$OUT/classifiers-d2-previous.json"
 fi
 
+# The default root (`--root feet-along-source`: the planted feet carry it
+# within a stride, the source's path beyond a second).
 "$BIN/style_eval" --sources walk,walk-turn-left,walk-turn-right --styles walk \
   --classifier-contents "$WALKS" --filmstrips bench/style/filmstrips \
   --json "$OUT/eval.json" --markdown "$OUT/eval.md" "$DATA/dataset-1" "$DATA/dataset-2"
+# The report's root: the source's path, time-warped (the default before session 12).
+"$BIN/style_eval" --root source --sources walk,walk-turn-left,walk-turn-right --styles walk \
+  --classifier-contents "$WALKS" --json "$OUT/eval-root-source.json" \
+  --markdown "$OUT/eval-root-source.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 
 "$BIN/style_speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
   "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 | tee "$OUT/speed.md"
 
 if flag --patches; then
-  # Sensitivity to the patch length (the default, 32, is the main run).
+  # Sensitivity to the patch length (the default, 32, is the main run),
+  # measured with the source's root (session 7).
   for P in 16 24 48; do
-    "$BIN/style_eval" --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    "$BIN/style_eval" --root source --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
       --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-p$P.json" \
       --markdown "$OUT/eval-p$P.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
   done
@@ -75,8 +82,8 @@ fi
 
 if flag --contacts; then
   # Foot-contact cleanup (two-bone IK pinning the ankles on the ground),
-  # off by default: its trade-off is measured here.
-  "$BIN/style_eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+  # off by default: its trade-off is measured here, with the source's root.
+  "$BIN/style_eval" --root source --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
     --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-contacts.json" \
     --markdown "$OUT/eval-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
   # The root carried by the planted feet instead of the source's path

@@ -482,24 +482,44 @@ fn style_apply_restyles_the_bundled_walk() {
         "time scale {scale}"
     );
 
-    // With the root carried by the planted feet the same restyle slides its
-    // feet less, and says how far they carried it.
-    let (path_report, path_motion) = restyle(&[]);
+    // On the source's path (the report's root) the feet slide; carried by
+    // the planted feet within each stride (the default) or everywhere, the
+    // same restyle slides them less, and the report says how far the feet
+    // moved the root. Only the default and the source's path keep the
+    // distance the source covers.
+    let (path_report, path_motion) = restyle(&["--root", "source"]);
+    let (along_report, along_motion) = restyle(&[]);
     let (feet_report, feet_motion) = restyle(&["--root-from-feet"]);
-    assert_eq!(feet_report["root_from_feet"], true);
+    assert_eq!(path_report["root"], "source");
+    assert_eq!(along_report["root"], "feet-along-source");
+    assert_eq!(feet_report["root"], "feet");
     assert_eq!(path_motion.frame_count(), feet_motion.frame_count());
+    assert_eq!(path_motion.frame_count(), along_motion.frame_count());
     let rig = RigLayout::from_skeleton(path_motion.skeleton()).unwrap();
-    let (sliding, carried) = (
-        foot_skating(&path_motion, &rig),
-        foot_skating(&feet_motion, &rig),
-    );
-    assert!(
-        carried < 0.85 * sliding,
-        "foot skating {sliding} -> {carried}"
-    );
-    assert!((path_report["distance_ratio"].as_f64().unwrap() - 1.0).abs() < 0.02);
+    let sliding = foot_skating(&path_motion, &rig);
+    for (what, motion) in [("along", &along_motion), ("feet", &feet_motion)] {
+        let carried = foot_skating(motion, &rig);
+        assert!(
+            carried < 0.9 * sliding,
+            "{what}: foot skating {sliding} -> {carried}"
+        );
+    }
+    assert_eq!(path_report["root_shift"]["max"], 0.0);
+    for report in [&path_report, &along_report] {
+        let ratio = report["distance_ratio"].as_f64().unwrap();
+        assert!((ratio - 1.0).abs() < 0.03, "distance ratio {ratio}");
+    }
     let ratio = feet_report["distance_ratio"].as_f64().unwrap();
     assert!((0.7..1.3).contains(&ratio), "distance ratio {ratio}");
+    // Within a stride the feet move the root a few centimetres; everywhere,
+    // further.
+    let shift = |r: &serde_json::Value| r["root_shift"]["mean"].as_f64().unwrap();
+    assert!(
+        0.0 < shift(&along_report) && shift(&along_report) < shift(&feet_report),
+        "root shift {} and {}",
+        shift(&along_report),
+        shift(&feet_report)
+    );
 
     // A bad duration and a missing style clip are input errors (1).
     let out = apply(&["--fade-in", "soon"]);

@@ -9,6 +9,7 @@
 
 use std::path::PathBuf;
 
+use mocap_style::convert::RootPath;
 use mocap_style::eval::{evaluate, EvalOptions};
 
 fn main() {
@@ -30,7 +31,8 @@ fn main() {
             "--styles" => options.style_contents = list(value()),
             "--classifier-contents" => options.classifier_filter.contents = list(value()),
             "--foot-contacts" => options.convert.foot_contacts = true,
-            "--root-from-feet" => options.convert.root_from_feet = true,
+            "--root-from-feet" => options.convert.root = RootPath::Feet,
+            "--root" => options.convert.root = value().parse().expect("--root PATH"),
             "--patch" => options.convert.patch = value().parse().expect("--patch N"),
             "--style-descriptor" => {
                 options.style_descriptor = serde_json::from_value(serde_json::json!(value()))

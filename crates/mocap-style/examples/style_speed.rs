@@ -15,7 +15,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::ops::trim;
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
-use mocap_style::convert::{ConvertOptions, Method};
+use mocap_style::convert::{ConvertOptions, Method, RootPath};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -55,10 +55,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| method | total (ms) | prepare | encode | match | decode | compose | output frames |"
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
-    for (method, root_from_feet) in [
-        (Method::ElasticPatches, false),
-        (Method::FixedPatches, false),
-        (Method::ElasticPatches, true),
+    for (method, root) in [
+        (Method::ElasticPatches, RootPath::FeetAlongSource),
+        (Method::FixedPatches, RootPath::FeetAlongSource),
+        (Method::ElasticPatches, RootPath::Source),
+        (Method::ElasticPatches, RootPath::Feet),
     ] {
         let mut all: Vec<StageTimings> = Vec::new();
         let mut out_frames = 0;
@@ -67,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let clip = prepare_style(&model, &style_motion, "style", &mut t)?;
             let options = ConvertOptions {
                 method,
-                root_from_feet,
+                root,
                 ..ConvertOptions::default()
             };
             let r = restyle(&model, &source, &[(&clip, 1.0)], &options, t)?;
@@ -79,13 +80,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let total = ms(&|t| t.total());
         let share = |v: f64| format!("{v:.1} ms ({:.0}%)", 100.0 * v / total);
         println!(
-            "| {}{} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| {}, root {} | {:.1} | {} | {} | {} | {} | {} | {} |",
             method.name(),
-            if root_from_feet {
-                ", root from feet"
-            } else {
-                ""
-            },
+            root.name(),
             total,
             share(ms(&|t| t.prepare)),
             share(ms(&|t| t.encode)),

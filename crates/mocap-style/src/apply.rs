@@ -5,11 +5,14 @@
 //!
 //! The output keeps the source's skeleton (bone lengths) and frame rate.
 //! The root's horizontal path and heading come from the source (time-warped
-//! with the patches), its height from the style clip, scaled by the ratio of
+//! with the patches, see below for the root's path within a stride), its height from the style clip, scaled by the ratio of
 //! the two performers' leg lengths (heights are measured from the world
-//! origin, i.e. the ground of the capture). With `root_from_feet` the
-//! horizontal path is instead carried by the output's own planted feet, so
-//! they do not slide ([`crate::contact`]). A style clip must be of the same
+//! origin, i.e. the ground of the capture). By default
+//! ([`RootPath::FeetAlongSource`]) the output's own planted feet carry the
+//! root within each stride, so they slide less, while over spans longer
+//! than a second it keeps to the source's path ([`crate::contact`]);
+//! [`RootPath::Source`] is the report's root, [`RootPath::Feet`] lets the
+//! feet set the whole path. A style clip must be of the same
 //! rig as the model (same joint names and hierarchy; other bone lengths are
 //! fine). [`apply`] retargets clips of other rigs
 //! ([`mocap_core::retarget`], body parts matched by joint name): a style
@@ -35,9 +38,9 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::{
-    clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions,
+    clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions, RootShift,
 };
-use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, StyleInput};
+use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, RootPath, StyleInput};
 use crate::data::mirrored;
 use crate::features::{compose, decompose, sample_frames, RootTrack};
 use crate::train::StyleModel;
@@ -62,10 +65,9 @@ pub struct ApplyOptions {
     pub blend: Option<(PathBuf, f32)>,
     /// Patch length in frames (default 32).
     pub patch: usize,
-    /// Move the root with the planted feet instead of along the source's
-    /// path ([`crate::contact::root_from_feet`]).
+    /// Where the root goes (default [`RootPath::FeetAlongSource`]).
     #[serde(default)]
-    pub root_from_feet: bool,
+    pub root: RootPath,
     /// Pin the ankles on the ground by turning hips and knees
     /// ([`crate::contact::clean_foot_contacts`]).
     #[serde(default)]
@@ -90,7 +92,7 @@ impl ApplyOptions {
             fade_in_seconds: 0.0,
             blend: None,
             patch: ConvertOptions::default().patch,
-            root_from_feet: false,
+            root: RootPath::default(),
             foot_contacts: false,
             device: DeviceChoice::Cpu,
         }
@@ -183,6 +185,9 @@ pub struct Restyled {
     pub motion: Motion,
     pub conversion: Conversion,
     pub timings: StageTimings,
+    /// How far the feet moved the root from the source's path (file units;
+    /// zero with [`RootPath::Source`]).
+    pub root_shift: RootShift,
 }
 
 /// Restyles `source` (any frame rate; output at the same rate) to the
@@ -240,9 +245,9 @@ pub fn restyle(
     let t = Instant::now();
     let out_rotations = model.description.normalization.rotations(&decoded);
     let mut motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
-    if options.root_from_feet {
-        root_from_feet(&mut motion, rig, &RootFromFeetOptions::default());
-    }
+    let root_shift = RootFromFeetOptions::for_path(options.root)
+        .map(|feet| root_from_feet(&mut motion, rig, &feet))
+        .unwrap_or_default();
     if options.foot_contacts {
         clean_foot_contacts(&mut motion, rig, &ContactOptions::default());
     }
@@ -256,6 +261,7 @@ pub fn restyle(
         motion,
         conversion,
         timings,
+        root_shift,
     })
 }
 
@@ -292,7 +298,10 @@ pub struct ApplyReport {
     pub strength: f32,
     pub fade_in_seconds: f64,
     pub patch: usize,
-    pub root_from_feet: bool,
+    pub root: RootPath,
+    /// How far the planted feet moved the root from the source's path,
+    /// horizontally (file units, on the model's rig).
+    pub root_shift: RootShift,
     pub foot_contacts: bool,
     pub source_frames: usize,
     pub output_frames: usize,
@@ -300,9 +309,8 @@ pub struct ApplyReport {
     /// Output duration over source duration (1 without elastic patches).
     pub time_scale: f64,
     /// Horizontal distance the pelvis travels in the output over the
-    /// distance it travels in the source (1 up to sampling when the root
-    /// follows the source's path; the strides set it with
-    /// `root_from_feet`).
+    /// distance it travels in the source (about 1 when the root follows the
+    /// source's path; the strides set it with [`RootPath::Feet`]).
     pub distance_ratio: f64,
     /// Mean source frames per patch over the patch length (main series).
     pub mean_patch_stretch: f64,
@@ -450,7 +458,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         patch: options.patch,
         strength: options.strength,
         fade_in_frames: (options.fade_in_seconds * model.description.fps) as f32,
-        root_from_feet: options.root_from_feet,
+        root: options.root,
         foot_contacts: options.foot_contacts,
         ..ConvertOptions::default()
     };
@@ -493,7 +501,8 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         strength: options.strength,
         fade_in_seconds: options.fade_in_seconds,
         patch: options.patch,
-        root_from_feet: options.root_from_feet,
+        root: options.root,
+        root_shift: restyled.root_shift,
         foot_contacts: options.foot_contacts,
         source_frames: source.frame_count(),
         output_frames: output.frame_count(),

@@ -14,11 +14,18 @@
 //! leaves every joint rotation alone and moves the root instead, so that the
 //! feet on the ground stand still and the body is carried by its strides
 //! (root motion taken from the feet, as games drive a character). The path
-//! then follows the style's strides rather than the source's.
+//! then follows the style's strides rather than the source's
+//! ([`RootPath::Feet`]). With
+//! [`RootFromFeetOptions::keep_source_path_seconds`] (the default root,
+//! [`RootPath::FeetAlongSource`]) the feet lead only within a stride: the
+//! slow part of the shift they ask for is taken away again, so over spans
+//! longer than a second the root keeps to the source's path.
 
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, GlobalPoses, Motion};
+use serde::{Deserialize, Serialize};
 
+use crate::convert::RootPath;
 use crate::features::{up_axis, RigLayout};
 
 /// Settings of [`clean_foot_contacts`].
@@ -176,6 +183,30 @@ pub struct RootFromFeetOptions {
     /// frame-to-frame steps, in seconds: the votes carry the decoder's
     /// jitter.
     pub smoothing_seconds: f32,
+    /// When set, the feet lead the root only within about this many
+    /// seconds: the difference between the feet's path and the source's
+    /// is high-passed (minus its slow course, a gaussian-weighted local
+    /// line of this standard deviation in seconds), so over longer spans the
+    /// root follows the source's path, its shape and length, while within a
+    /// stride the planted foot carries it.
+    pub keep_source_path_seconds: Option<f32>,
+}
+
+impl RootFromFeetOptions {
+    /// The settings for a [`RootPath`]: `None` for the source's path;
+    /// [`RootPath::FeetAlongSource`] keeps the source's path beyond one
+    /// second, about one gait cycle (a walk's is 1.0-1.3 s), so that the
+    /// feet lead only within a stride.
+    pub fn for_path(path: RootPath) -> Option<RootFromFeetOptions> {
+        match path {
+            RootPath::Source => None,
+            RootPath::FeetAlongSource => Some(RootFromFeetOptions {
+                keep_source_path_seconds: Some(1.0),
+                ..RootFromFeetOptions::default()
+            }),
+            RootPath::Feet => Some(RootFromFeetOptions::default()),
+        }
+    }
 }
 
 impl Default for RootFromFeetOptions {
@@ -188,6 +219,7 @@ impl Default for RootFromFeetOptions {
             height_scale: 0.01,
             speed_scale: 0.1,
             smoothing_seconds: 0.05,
+            keep_source_path_seconds: None,
         }
     }
 }
@@ -202,11 +234,15 @@ impl Default for RootFromFeetOptions {
 /// foot pivots on: the heel after it strikes, the ball of the foot as the
 /// heel rises. With no foot near the ground the root keeps its own step.
 /// The steps are then smoothed along time.
-pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFeetOptions) {
+pub fn root_from_feet(
+    motion: &mut Motion,
+    rig: &RigLayout,
+    options: &RootFromFeetOptions,
+) -> RootShift {
     let poses = forward_kinematics(motion);
     let n = poses.frame_count;
     if n < 2 {
-        return;
+        return RootShift::default();
     }
     let up = up_axis(&poses.positions, poses.joint_count, rig);
     let horizontal = |p: Vec3| p - up * p.dot(up);
@@ -264,14 +300,91 @@ pub fn root_from_feet(motion: &mut Motion, rig: &RigLayout, options: &RootFromFe
         steps[f] = vote / total * on_ground + own[f] * (1.0 - on_ground);
     }
     let steps = smooth_steps(&steps, options.smoothing_seconds * motion.fps() as f32);
-    let parent = motion.skeleton().joint(rig.pelvis).parent;
-    let mut shift = Vec3::ZERO;
+    // shift[f]: how far the feet's path is from the root's own at frame f.
+    let mut shift = vec![Vec3::ZERO; n];
     for f in 1..n {
-        shift += steps[f] - own[f];
+        shift[f] = shift[f - 1] + steps[f] - own[f];
+    }
+    if let Some(seconds) = options.keep_source_path_seconds {
+        let sigma = seconds * motion.fps() as f32;
+        let slow = local_linear_trend(&shift, sigma);
+        for (s, slow) in shift.iter_mut().zip(slow) {
+            *s -= slow;
+        }
+        // The clip starts and ends where the source does: what is left of
+        // the shift at either end is eased out over about half of `sigma`
+        // (a clip is often one of a sequence, so its ends are where the next
+        // one takes over). Without this a restyled walk started 11 cm off
+        // the source's first position.
+        let (first, last) = (shift[0], shift[n - 1]);
+        let tau = 0.5 * sigma.max(1.0);
+        for (f, s) in shift.iter_mut().enumerate() {
+            let ease = |d: usize| (-((d * d) as f32) / (2.0 * tau * tau)).exp();
+            *s -= first * ease(f) + last * ease(n - 1 - f);
+        }
+    }
+    let parent = motion.skeleton().joint(rig.pelvis).parent;
+    for (f, &shift) in shift.iter().enumerate() {
         let to_local = parent.map_or(Quat::IDENTITY, |p| poses.rotation(f, p).inverse());
         let t = motion.local_translation(f, rig.pelvis);
         motion.set_local_translation(f, rig.pelvis, t + to_local * shift);
     }
+    let lengths = shift.iter().map(|s| s.length());
+    RootShift {
+        mean: lengths.clone().sum::<f32>() / n as f32,
+        max: lengths.fold(0.0, f32::max),
+    }
+}
+
+/// How far [`root_from_feet`] moved the root from its own path,
+/// horizontally, in file units.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct RootShift {
+    /// Mean over the frames.
+    pub mean: f32,
+    /// Largest over the frames.
+    pub max: f32,
+}
+
+/// The slow course of a series: at every frame, the value at that frame of
+/// the straight line fitted to the series by least squares with gaussian
+/// weights (standard deviation `sigma` frames). In the middle of a series
+/// this is plain gaussian smoothing; unlike it, it follows a steady trend
+/// up to the ends, where the window is one-sided (a cut, renormalised
+/// gaussian would lag a steady drag there by about `sigma` frames' worth).
+fn local_linear_trend(values: &[Vec3], sigma: f32) -> Vec<Vec3> {
+    if sigma <= 0.0 {
+        return values.to_vec();
+    }
+    let reach = (3.0 * sigma).ceil() as usize;
+    let n = values.len();
+    (0..n)
+        .map(|f| {
+            // Weighted sums of 1, d, d^2, y and d y, with d = g - f.
+            let (mut s0, mut s1, mut s2) = (0.0f32, 0.0f32, 0.0f32);
+            let (mut t0, mut t1) = (Vec3::ZERO, Vec3::ZERO);
+            for (g, &y) in values
+                .iter()
+                .enumerate()
+                .take((f + reach).min(n - 1) + 1)
+                .skip(f.saturating_sub(reach))
+            {
+                let d = g as f32 - f as f32;
+                let w = (-d * d / (2.0 * sigma * sigma)).exp();
+                s0 += w;
+                s1 += w * d;
+                s2 += w * d * d;
+                t0 += y * w;
+                t1 += y * (w * d);
+            }
+            let det = s0 * s2 - s1 * s1;
+            if det.abs() < 1e-9 * s0 * s0.max(s2) {
+                t0 / s0
+            } else {
+                (t0 * s2 - t1 * s1) / det
+            }
+        })
+        .collect()
 }
 
 /// Horizontal distance the pelvis travels over the clip (file units): the
@@ -480,6 +593,58 @@ mod tests {
             off < 0.1 * drag,
             "ends {off} from the real path after a drag of {drag}"
         );
+    }
+
+    /// Along the source's path, the feet undo sliding within a stride (a
+    /// fast sideways wobble of the root) but keep the path's slow course (a
+    /// steady drag stays, as it is the path the source gives).
+    #[test]
+    fn along_the_source_the_feet_undo_a_wobble_but_keep_the_course() {
+        let Some(real) = bandai_walk("dataset-1_walk_proud_002.bvh") else {
+            return;
+        };
+        let rig = RigLayout::from_skeleton(real.skeleton()).unwrap();
+        let fps = real.fps() as f32;
+        let along = RootFromFeetOptions::for_path(RootPath::FeetAlongSource).unwrap();
+        let moved = |offset: &dyn Fn(f32) -> Vec3| {
+            let mut motion = real.clone();
+            for f in 0..motion.frame_count() {
+                let t = motion.local_translation(f, rig.pelvis);
+                motion.set_local_translation(f, rig.pelvis, t + offset(f as f32 / fps));
+            }
+            motion
+        };
+        let pelvis = |m: &Motion| {
+            let poses = forward_kinematics(m);
+            (0..m.frame_count())
+                .map(|f| poses.position(f, rig.pelvis))
+                .collect::<Vec<_>>()
+        };
+        let mean_distance = |a: &[Vec3], b: &[Vec3]| {
+            a.iter().zip(b).map(|(p, q)| p.distance(*q)).sum::<f32>() / a.len() as f32
+        };
+        let real_path = pelvis(&real);
+
+        // A 6 cm sideways wobble at 2 Hz: the planted feet slide.
+        let mut motion =
+            moved(&|t| Vec3::new(6.0 * (std::f32::consts::TAU * 2.0 * t).sin(), 0.0, 0.0));
+        let sliding = foot_skating(&motion, &rig);
+        let real_skating = foot_skating(&real, &rig);
+        assert!(sliding > real_skating + 20.0, "{real_skating} -> {sliding}");
+        let shift = root_from_feet(&mut motion, &rig, &along);
+        let fixed = foot_skating(&motion, &rig);
+        assert!(fixed < real_skating + 3.0, "{sliding} -> {fixed}");
+        let off = mean_distance(&pelvis(&motion), &real_path);
+        assert!(off < 1.5, "{off} from the real path on average");
+        assert!(shift.mean > 2.0 && shift.max < 12.0, "{shift:?}");
+
+        // A steady drag of 40 cm/s is the source's course: kept, within a
+        // few centimetres, where the feet alone undo it.
+        let dragged = moved(&|t| Vec3::new(40.0 * t, 0.0, 0.0));
+        let mut motion = dragged.clone();
+        root_from_feet(&mut motion, &rig, &along);
+        let off = mean_distance(&pelvis(&motion), &pelvis(&dragged));
+        assert!(off < 1.5, "{off} from the dragged path on average");
     }
 
     #[test]

@@ -117,6 +117,50 @@ fn sample_track(track: &[f32], t: f32) -> f32 {
     (1.0 - a) * track[i] + a * track[j]
 }
 
+/// Where the output's root (the pelvis's horizontal position) goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RootPath {
+    /// Along the source's path, time-warped with the output (the report's
+    /// method): the decoded strides slide on it.
+    Source,
+    /// Along the source's path over spans longer than a second (its shape
+    /// and length), carried by the planted feet within a stride
+    /// ([`crate::contact::root_from_feet`] with
+    /// [`crate::contact::RootFromFeetOptions::keep_source_path_seconds`]).
+    #[default]
+    FeetAlongSource,
+    /// Carried by the planted feet everywhere: the path's shape and length
+    /// follow the strides ([`crate::contact::root_from_feet`]).
+    Feet,
+}
+
+impl RootPath {
+    pub const ALL: [RootPath; 3] = [RootPath::Source, RootPath::FeetAlongSource, RootPath::Feet];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RootPath::Source => "source",
+            RootPath::FeetAlongSource => "feet-along-source",
+            RootPath::Feet => "feet",
+        }
+    }
+}
+
+impl std::str::FromStr for RootPath {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        RootPath::ALL
+            .into_iter()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = RootPath::ALL.iter().map(|r| r.name()).collect();
+                format!("unknown root path `{s}` (expected {})", names.join(", "))
+            })
+    }
+}
+
 /// How the source's latent codes are converted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -184,11 +228,10 @@ pub struct ConvertOptions {
     /// ([`crate::contact`]); applied by [`crate::apply::restyle`].
     #[serde(default)]
     pub foot_contacts: bool,
-    /// Move the root with the feet on the ground after decoding
-    /// ([`crate::contact::root_from_feet`]) instead of along the source's
-    /// path; applied by [`crate::apply::restyle`] before `foot_contacts`.
+    /// Where the root goes ([`RootPath`]); applied by
+    /// [`crate::apply::restyle`] after decoding, before `foot_contacts`.
     #[serde(default)]
-    pub root_from_feet: bool,
+    pub root: RootPath,
 }
 
 impl Default for ConvertOptions {
@@ -201,7 +244,7 @@ impl Default for ConvertOptions {
             strength: 1.0,
             fade_in_frames: 0.0,
             foot_contacts: false,
-            root_from_feet: false,
+            root: RootPath::default(),
         }
     }
 }

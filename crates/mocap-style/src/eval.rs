@@ -147,9 +147,13 @@ pub struct MethodScores {
     pub time_scale: f64,
     /// Mean distance the pelvis travels horizontally in the output over
     /// the distance it travels in the source (1 when the root follows the
-    /// source's path; the feet set it with `root_from_feet`).
+    /// source's path; the feet set it with `RootPath::Feet`).
     #[serde(default)]
     pub distance_ratio: f64,
+    /// Mean horizontal distance between the output's root and where the
+    /// source's path puts it (file units; 0 with `RootPath::Source`).
+    #[serde(default)]
+    pub root_shift: f64,
     /// Mean seconds per restyle (prepare to compose, style encoding included).
     pub seconds_per_pair: f64,
 }
@@ -170,6 +174,10 @@ pub struct PairResult {
     pub time_scale: f64,
     #[serde(default)]
     pub distance_ratio: f64,
+    /// Mean horizontal distance the feet moved the root from the source's
+    /// path (file units).
+    #[serde(default)]
+    pub root_shift: f64,
     pub timings: StageTimings,
 }
 
@@ -654,6 +662,7 @@ fn evaluate_set(
                     jitter: motion_jitter(out),
                     time_scale: out.duration() / source.motion.duration(),
                     distance_ratio: (travelled(out, rig) / source_distance) as f64,
+                    root_shift: restyled.root_shift.mean as f64,
                     timings: restyled.timings,
                 });
             }
@@ -671,6 +680,7 @@ fn evaluate_set(
                 jitter: motion_jitter(&source.motion),
                 time_scale: 1.0,
                 distance_ratio: 1.0,
+                root_shift: 0.0,
                 timings: StageTimings::default(),
             });
         }
@@ -741,6 +751,7 @@ fn evaluate_set(
             jitter: mean(&|r| r.jitter),
             time_scale: mean(&|r| r.time_scale),
             distance_ratio: mean(&|r| r.distance_ratio),
+            root_shift: mean(&|r| r.root_shift),
             seconds_per_pair: mean(&|r| r.timings.total()),
         }
     };
@@ -771,6 +782,7 @@ fn evaluate_set(
                 jitter: motion_jitter(&c.motion),
                 time_scale: 1.0,
                 distance_ratio: 1.0,
+                root_shift: 0.0,
                 timings: StageTimings::default(),
             })
         })
@@ -890,14 +902,14 @@ impl EvalReport {
             s.push_str(
                 "| method | pairs | style acc. | style acc. where the classifier knows the style clip | content acc. | \\|T_out - T_style\\| (s) | \
                  \\|T_out - T_source\\| (s) | closer to style | foot skating (units/s) | jitter \
-                 (units/frame³) | duration ratio | distance ratio | s per restyle |\n",
+                 (units/frame³) | duration ratio | distance ratio | root off the source's path (units) | s per restyle |\n",
             );
             s.push_str(
-                "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+                "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
             );
             for m in set.reference.iter().chain(&set.methods) {
                 s.push_str(&format!(
-                    "| {} | {} | {:.1}% | {:.1}% ({} pairs) | {:.1}% | {:.3} | {:.3} | {:.0}% ({} timed) | {:.2} | {:.4} | {:.2} | {:.2} | {:.3} |\n",
+                    "| {} | {} | {:.1}% | {:.1}% ({} pairs) | {:.1}% | {:.3} | {:.3} | {:.0}% ({} timed) | {:.2} | {:.4} | {:.2} | {:.2} | {:.2} | {:.3} |\n",
                     m.method,
                     m.pairs,
                     100.0 * m.style_accuracy,
@@ -912,6 +924,7 @@ impl EvalReport {
                     m.jitter,
                     m.time_scale,
                     m.distance_ratio,
+                    m.root_shift,
                     m.seconds_per_pair,
                 ));
             }

@@ -79,7 +79,7 @@ fn restyled_walk_keeps_the_source_rig_and_takes_the_style_timing() {
         let horizontal = (d.x * d.x + d.z * d.z).sqrt();
         assert!(
             horizontal < 5.0,
-            "pelvis {horizontal} cm off the source's path"
+            "pelvis {horizontal} cm off the source's path at frame {fb}"
         );
     }
     let p_out = gait_period(out, &rig).unwrap();

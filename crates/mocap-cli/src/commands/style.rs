@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context};
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::Method;
+use mocap_style::convert::{Method, RootPath};
 use mocap_style::eval::{evaluate, EvalOptions};
 use mocap_style::train::{train, TrainOptions};
 
@@ -103,9 +103,14 @@ struct ApplyArgs {
     /// Patch length in frames.
     #[arg(long)]
     patch: Option<usize>,
-    /// Let the planted feet carry the body instead of the source's path: no foot sliding, but the
-    /// distance covered follows the strides (reported as the distance ratio).
-    #[arg(long)]
+    /// Where the body goes: `feet-along-source` (default: the planted feet carry it within a
+    /// stride, the source's path over longer spans), `source` (the source's path, time-warped:
+    /// the report's method; the feet slide more) or `feet` (the feet everywhere: no sliding, but
+    /// the distance covered follows the strides, reported as the distance ratio).
+    #[arg(long, value_name = "PATH", default_value = "feet-along-source")]
+    root: RootPath,
+    /// Same as `--root feet`.
+    #[arg(long, conflicts_with = "root")]
     root_from_feet: bool,
     /// Pin the ankles on the ground by turning hips and knees (keeps the source's path; costs
     /// some style, see bench/results/style.md).
@@ -140,8 +145,11 @@ struct EvalArgs {
     /// Patch length in frames.
     #[arg(long)]
     patch: Option<usize>,
-    /// Restyle with the root carried by the planted feet (as `apply --root-from-feet`).
-    #[arg(long)]
+    /// Where the body goes, as `apply --root`.
+    #[arg(long, value_name = "PATH", default_value = "feet-along-source")]
+    root: RootPath,
+    /// Same as `--root feet`.
+    #[arg(long, conflicts_with = "root")]
     root_from_feet: bool,
     /// Restyle with the ankles pinned on the ground (as `apply --foot-contacts`).
     #[arg(long)]
@@ -231,7 +239,11 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if let Some(patch) = a.patch {
                 apply_options.patch = patch;
             }
-            apply_options.root_from_feet = a.root_from_feet;
+            apply_options.root = if a.root_from_feet {
+                RootPath::Feet
+            } else {
+                a.root
+            };
             apply_options.foot_contacts = a.foot_contacts;
             apply_options.device = a.device;
             let report = apply(&apply_options)?;
@@ -271,7 +283,11 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             if let Some(patch) = a.patch {
                 eval_options.convert.patch = patch;
             }
-            eval_options.convert.root_from_feet = a.root_from_feet;
+            eval_options.convert.root = if a.root_from_feet {
+                RootPath::Feet
+            } else {
+                a.root
+            };
             eval_options.convert.foot_contacts = a.foot_contacts;
             let report = evaluate(&eval_options)?;
             let markdown = report.to_markdown();
