@@ -318,8 +318,8 @@ pub fn root_from_feet(
         // the source's first position.
         let (first, last) = (shift[0], shift[n - 1]);
         let tau = 0.5 * sigma.max(1.0);
+        let ease = |d: usize| (-((d * d) as f32) / (2.0 * tau * tau)).exp();
         for (f, s) in shift.iter_mut().enumerate() {
-            let ease = |d: usize| (-((d * d) as f32) / (2.0 * tau * tau)).exp();
             *s -= first * ease(f) + last * ease(n - 1 - f);
         }
     }
