@@ -6,7 +6,7 @@
 //! cargo run -p mocap-style --example classifiers -- [--cv | --cv-style | --cv-content] \
 //!     [--classifier-contents walk,walk-back] [--style-descriptor gait] \
 //!     [--content-descriptor intervals-gait] [--style-window 2] [--content-window 2] \
-//!     [--style-model forest|nearest-mean] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] DIR...
+//!     [--style-model forest|nearest-mean|discriminant] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] DIR...
 //! ```
 
 use std::path::PathBuf;
@@ -41,6 +41,7 @@ fn main() {
             }
             "--style-model" => options.style_model = descriptor(value()),
             "--content-model" => options.content_model = descriptor(value()),
+            "--shrinkage" => options.shrinkage = value().parse().expect("shrinkage"),
             "--seed" => options.seed = value().parse().expect("seed"),
             "--style-hop" => options.style_windows.hop = value().parse().expect("seconds"),
             "--mirror" => options.style_mirror_training = true,

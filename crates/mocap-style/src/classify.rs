@@ -17,6 +17,7 @@ use mocap_search::features::motion_features;
 use mocap_search::forest::Samples;
 use mocap_search::intervals::{FeatureSequence, IntervalLayout};
 use mocap_search::{Forest, ForestConfig};
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use crate::data::{mirrored, Clip};
@@ -329,6 +330,15 @@ pub enum Model {
     /// forest. A clip's label is the class nearest on average over its
     /// windows.
     NearestMean,
+    /// Linear discriminant analysis with a shrunk covariance: the class
+    /// means, and the pooled within-class correlation of the values shrunk
+    /// towards the identity, `R_s = (1 - s) R + s I`
+    /// ([`ClassifierConfig::shrinkage`] = `s`). A clip's label is the class
+    /// nearest in that Mahalanobis distance on average over its windows. At
+    /// `s = 1` it is [`Model::NearestMean`]; below, values that move
+    /// together (the deviation and rate of change of one joint) stop being
+    /// counted twice.
+    Discriminant,
 }
 
 /// How a classifier is built.
@@ -345,6 +355,9 @@ pub struct ClassifierConfig {
     /// a mirrored walk has the same style and there are few takes per style.
     /// Not for contents whose name says a side (walk-left).
     pub mirror_training: bool,
+    /// Shrinkage `s` of [`Model::Discriminant`]'s correlation towards the
+    /// identity, in `(0, 1]`.
+    pub shrinkage: f64,
     pub seed: u64,
 }
 
@@ -364,10 +377,20 @@ enum Fitted {
         /// that never varies within a class).
         weights: Vec<f64>,
     },
+    Discriminant {
+        /// Class means, `classes x dim`.
+        means: Vec<Vec<f64>>,
+        /// 1 / pooled within-class deviation of every value (0 for a value
+        /// that never varies within a class).
+        scales: Vec<f64>,
+        /// Inverse of the shrunk within-class correlation of the scaled
+        /// values.
+        precision: DMatrix<f64>,
+    },
 }
 
-/// The class means and inverse pooled within-class variances of rows.
-fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) -> Fitted {
+/// Class means of rows, `classes x dim`.
+fn class_means(rows: &[f32], dim: usize, labels: &[u32], classes: usize) -> Vec<Vec<f64>> {
     let mut sums = vec![vec![0.0f64; dim]; classes];
     let mut counts = vec![0usize; classes];
     for (row, &l) in rows.chunks(dim).zip(labels) {
@@ -376,11 +399,69 @@ fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) ->
             *s += v as f64;
         }
     }
-    let means: Vec<Vec<f64>> = sums
-        .into_iter()
+    sums.into_iter()
         .zip(&counts)
         .map(|(s, &n)| s.into_iter().map(|v| v / n.max(1) as f64).collect())
+        .collect()
+}
+
+/// [`Model::Discriminant`]: class means, and the inverse of the pooled
+/// within-class correlation shrunk towards the identity by `shrinkage`.
+fn fit_discriminant(
+    rows: &[f32],
+    dim: usize,
+    labels: &[u32],
+    classes: usize,
+    shrinkage: f64,
+) -> Result<Fitted> {
+    if !(shrinkage > 0.0 && shrinkage <= 1.0) {
+        return Err(invalid(format!(
+            "classifier: shrinkage must be in (0, 1], got {shrinkage}"
+        )));
+    }
+    let means = class_means(rows, dim, labels, classes);
+    let n = labels.len().max(1) as f64;
+    let mut covariance = DMatrix::<f64>::zeros(dim, dim);
+    let mut d = DVector::<f64>::zeros(dim);
+    for (row, &l) in rows.chunks(dim).zip(labels) {
+        for (c, (&x, m)) in row.iter().zip(&means[l as usize]).enumerate() {
+            d[c] = x as f64 - m;
+        }
+        covariance.syger(1.0 / n, &d, &d, 1.0);
+    }
+    covariance.fill_upper_triangle_with_lower_triangle();
+    let scales: Vec<f64> = (0..dim)
+        .map(|c| {
+            let v = covariance[(c, c)];
+            if v > 1e-12 {
+                1.0 / v.sqrt()
+            } else {
+                0.0
+            }
+        })
         .collect();
+    // R_s = (1 - s) D^-1/2 C D^-1/2 + s I; values that never vary are
+    // left out by a zero scale, so their row of R is 0 and of R_s is s.
+    let mut shrunk = DMatrix::<f64>::identity(dim, dim) * shrinkage;
+    for i in 0..dim {
+        for j in 0..dim {
+            shrunk[(i, j)] += (1.0 - shrinkage) * covariance[(i, j)] * scales[i] * scales[j];
+        }
+    }
+    let precision = shrunk
+        .cholesky()
+        .ok_or_else(|| invalid("classifier: the shrunk correlation is not positive definite"))?
+        .inverse();
+    Ok(Fitted::Discriminant {
+        means,
+        scales,
+        precision,
+    })
+}
+
+/// The class means and inverse pooled within-class variances of rows.
+fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) -> Fitted {
+    let means = class_means(rows, dim, labels, classes);
     let mut variance = vec![0.0f64; dim];
     for (row, &l) in rows.chunks(dim).zip(labels) {
         for ((v, &x), m) in variance.iter_mut().zip(row).zip(&means[l as usize]) {
@@ -393,6 +474,47 @@ fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) ->
         .map(|v| if v / n > 1e-12 { n / v } else { 0.0 })
         .collect();
     Fitted::NearestMean { means, weights }
+}
+
+impl Fitted {
+    /// Adds one window row's score for every class to `votes` (the forest's
+    /// histogram, or minus the squared distance to each class mean).
+    fn add_votes(&self, row: &[f32], votes: &mut [f32]) {
+        match self {
+            Fitted::Forest(forest) => {
+                for (v, h) in votes.iter_mut().zip(forest.predict(row)) {
+                    *v += h;
+                }
+            }
+            Fitted::NearestMean { means, weights } => {
+                for (v, mean) in votes.iter_mut().zip(means) {
+                    let d2: f64 = row
+                        .iter()
+                        .zip(mean)
+                        .zip(weights)
+                        .map(|((&x, m), w)| (x as f64 - m).powi(2) * w)
+                        .sum();
+                    *v -= d2 as f32;
+                }
+            }
+            Fitted::Discriminant {
+                means,
+                scales,
+                precision,
+            } => {
+                for (v, mean) in votes.iter_mut().zip(means) {
+                    let z = DVector::from_iterator(
+                        row.len(),
+                        row.iter()
+                            .zip(mean)
+                            .zip(scales)
+                            .map(|((&x, m), s)| (x as f64 - m) * s),
+                    );
+                    *v -= z.dot(&(precision * &z)) as f32;
+                }
+            }
+        }
+    }
 }
 
 impl ClipClassifier {
@@ -431,6 +553,9 @@ impl ClipClassifier {
                 Fitted::Forest(Forest::train(&samples, &forest, &|| {}))
             }
             Model::NearestMean => fit_nearest_mean(&rows, dim, &labels, classes.len()),
+            Model::Discriminant => {
+                fit_discriminant(&rows, dim, &labels, classes.len(), config.shrinkage)?
+            }
         };
         Ok(ClipClassifier {
             config,
@@ -445,24 +570,7 @@ impl ClipClassifier {
         let mut votes = vec![0.0f32; self.classes.len()];
         for w in feature_windows(motion, self.config.windows)? {
             let row = descriptor_row(self.config.descriptor, &w, motion.fps());
-            match &self.fitted {
-                Fitted::Forest(forest) => {
-                    for (v, h) in votes.iter_mut().zip(forest.predict(&row)) {
-                        *v += h;
-                    }
-                }
-                Fitted::NearestMean { means, weights } => {
-                    for (v, mean) in votes.iter_mut().zip(means) {
-                        let d2: f64 = row
-                            .iter()
-                            .zip(mean)
-                            .zip(weights)
-                            .map(|((&x, m), w)| (x as f64 - m).powi(2) * w)
-                            .sum();
-                        *v -= d2 as f32;
-                    }
-                }
-            }
+            self.fitted.add_votes(&row, &mut votes);
         }
         Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
     }
@@ -521,6 +629,50 @@ mod tests {
         // Pooled variance of value 0: 0.01, of value 1: 100.
         assert!((weights[0] - 100.0).abs() < 1e-3, "{weights:?}");
         assert!((weights[1] - 0.01).abs() < 1e-6, "{weights:?}");
+    }
+
+    #[test]
+    fn discriminant_counts_values_that_move_together_once() {
+        // Two classes whose two values have unit within-class deviation and
+        // correlation 0.9: each class is the points +-(1, 1) sqrt(1.9) and
+        // +-(1, -1) sqrt(0.1) about its mean, (0, 0) and (2, 0).
+        let (a, b) = (1.9f32.sqrt(), 0.1f32.sqrt());
+        let spread = [(a, a), (-a, -a), (b, -b), (-b, b)];
+        let mut rows = Vec::new();
+        let mut labels = Vec::new();
+        for (class, centre) in [(0u32, 0.0f32), (1, 2.0)] {
+            for (x, y) in spread {
+                rows.extend([centre + x, y]);
+                labels.push(class);
+            }
+        }
+        let nearest = |fitted: &Fitted, row: &[f32]| {
+            let mut votes = [0.0f32; 2];
+            fitted.add_votes(row, &mut votes);
+            mocap_search::forest::argmax(&votes)
+        };
+        // (1.2, 1.5) lies along the shared swing from class 0's mean: the
+        // Mahalanobis distances are 2.4 (class 0) and 26.6 (class 1), the
+        // scaled Euclidean ones 3.7 and 2.9 (at correlation 0.9).
+        let point = [1.2f32, 1.5];
+        let diagonal = fit_nearest_mean(&rows, 2, &labels, 2);
+        assert_eq!(nearest(&diagonal, &point), 1);
+        let full = fit_discriminant(&rows, 2, &labels, 2, 0.01).unwrap();
+        assert_eq!(nearest(&full, &point), 0);
+        let Fitted::Discriminant { precision, .. } = &full else {
+            panic!("discriminant");
+        };
+        // inverse of [[1, r], [r, 1]] with r = 0.99 * 0.9.
+        let r = 0.99 * 0.9;
+        assert!((precision[(0, 0)] - 1.0 / (1.0 - r * r)).abs() < 1e-3);
+        assert!((precision[(0, 1)] + r / (1.0 - r * r)).abs() < 1e-3);
+        // Shrunk all the way, it is the nearest scaled mean.
+        let shrunk = fit_discriminant(&rows, 2, &labels, 2, 1.0).unwrap();
+        let (mut v1, mut v2) = ([0.0f32; 2], [0.0f32; 2]);
+        shrunk.add_votes(&point, &mut v1);
+        diagonal.add_votes(&point, &mut v2);
+        assert!((v1[0] - v2[0]).abs() < 1e-4 && (v1[1] - v2[1]).abs() < 1e-4);
+        assert!(fit_discriminant(&rows, 2, &labels, 2, 0.0).is_err());
     }
 
     #[test]

@@ -80,6 +80,9 @@ pub struct EvalOptions {
     /// Candidate features per tree node of both forests (the search
     /// crate's default when `None`).
     pub candidates: Option<usize>,
+    /// Shrinkage of both classifiers' covariance when their model is
+    /// [`Model::Discriminant`].
+    pub shrinkage: f64,
     pub seed: u64,
     /// Folder for filmstrip PNGs (none when `None`).
     pub filmstrips: Option<PathBuf>,
@@ -107,6 +110,7 @@ impl Default for EvalOptions {
             content_windows: Windows::default(),
             style_mirror_training: false,
             candidates: None,
+            shrinkage: 0.5,
             seed: 1,
             filmstrips: None,
             filmstrip_count: 3,
@@ -495,6 +499,7 @@ fn style_config(options: &EvalOptions) -> ClassifierConfig {
         trees: options.trees,
         candidates: options.candidates,
         mirror_training: options.style_mirror_training,
+        shrinkage: options.shrinkage,
         seed: options.seed,
     }
 }
@@ -507,6 +512,7 @@ fn content_config(options: &EvalOptions) -> ClassifierConfig {
         trees: options.trees,
         candidates: options.candidates,
         mirror_training: false,
+        shrinkage: options.shrinkage,
         seed: options.seed + 1,
     }
 }
