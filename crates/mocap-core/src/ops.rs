@@ -404,8 +404,10 @@ const FIT_TOLERANCE_DEG: f32 = 3.0;
 /// - a joint without rotation channels takes its parent's reflection (so it
 ///   stays unrotated);
 /// - a joint on the midline takes the reflection across the local
-///   coordinate plane nearest the sagittal plane in the first frame (the
-///   local axis nearest the world `lateral` axis), keeping its parent's
+///   coordinate plane nearest the body's sagittal plane in the first frame
+///   (the local axis nearest the direction from the right hip and shoulder
+///   to the left ones, or the world `lateral` axis when the pairs give
+///   none), keeping its parent's
 ///   plane while that is within 60 degrees, so its frame is mirrored onto
 ///   itself. This is read from the motion because the all-zero rest pose of
 ///   some rigs is no human pose (Bandai's lays every bone along its local X
@@ -423,11 +425,26 @@ pub fn mirror_frames(
     let twin = twins(skeleton, pairs)?;
     let s = reflection(lateral);
     let n = skeleton.joint_count();
-    // The world lateral axis in each joint's frame, in the first frame.
+    // The body's lateral direction in each joint's frame, in the first
+    // frame: across the pairs that hang from the midline (hips and
+    // shoulders), not the world axis `lateral`. Whatever plane the world is
+    // reflected across, a midline joint's frame must be reflected across
+    // its own local plane nearest the body's sagittal plane, so that its
+    // axes point along the mirrored body as they did along the body. Judged
+    // against the world axis instead, a performer facing 45 degrees off it
+    // had midline joints pick the wrong plane: the same positions, but
+    // rotations split into unnatural ones (a neck twisted half a turn; 35 of
+    // the 174 dataset-1 Bandai takes, most of the walks to the side).
     let lateral_in_joint: Vec<Option<Vec3>> = if motion.frame_count() > 0 {
         let poses = forward_kinematics(&trim(motion, 0..1)?);
+        let across: Vec3 = pairs
+            .iter()
+            .filter(|&&(left, _)| skeleton.joint(left).parent.is_some_and(|p| twin[p] == p))
+            .map(|&(left, right)| poses.position(0, left) - poses.position(0, right))
+            .sum();
+        let body_lateral = across.try_normalize().unwrap_or(lateral.unit());
         (0..n)
-            .map(|j| Some(poses.rotation(0, j).inverse() * lateral.unit()))
+            .map(|j| Some(poses.rotation(0, j).inverse() * body_lateral))
             .collect()
     } else {
         vec![None; n]
@@ -493,7 +510,10 @@ pub fn mirror_frames(
         let chosen = match (parent, lateral_in_joint[j]) {
             // A joint that cannot rotate must take its parent's frame.
             (Some(p), _) if keeps_rotation && allowed.iter().any(|&(c, _)| c == p) => p,
-            (parent, Some(n)) if on_midline => midline_reflection(parent, n),
+            // The root's frame hangs from the world's: it keeps the world's
+            // reflection while that is near the body's sagittal plane, so its
+            // rotation is mirrored by conjugation, `S R S`.
+            (parent, Some(n)) if on_midline => midline_reflection(parent.or(Some(s)), n),
             (None, None) if fits(s) => s,
             (Some(p), _) if fits(p) => p,
             _ if !on_midline && fits(-Mat3::IDENTITY) => -Mat3::IDENTITY,
@@ -509,10 +529,12 @@ pub fn mirror_frames(
 }
 
 /// The reflection across a local coordinate plane for a joint on the
-/// midline whose frame holds the world lateral axis as `n` (unit) in the
-/// first frame: the parent's plane while its normal stays within 60 degrees
-/// of `n` (so a head turned 50 degrees keeps the neck's plane), else the
-/// plane normal to the local axis nearest `n`.
+/// midline whose frame holds the body's lateral direction as `n` (unit) in
+/// the first frame: the parent's plane while its normal stays within 60
+/// degrees of `n` (so a head turned 50 degrees keeps the neck's plane; one
+/// turned further in the first frame gets its own plane, which keeps the
+/// positions but not the most natural rotations), else the plane normal to
+/// the local axis nearest `n`.
 fn midline_reflection(parent: Option<Mat3>, n: Vec3) -> Mat3 {
     if let Some(p) = parent {
         if let Some(normal) = reflection_normal(&p) {
