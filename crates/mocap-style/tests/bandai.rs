@@ -27,72 +27,95 @@ fn bandai(set: &str, name: &str) -> Option<PathBuf> {
     }
 }
 
-/// The output keeps the source's skeleton and frame rate, follows the
-/// source's path, and a style clip with a slower stride (proud: about 1.7 s
-/// against 0.9 s for this happy walk) makes the output longer with elastic
-/// patches, with a period closer to the style's, but not with fixed ones.
-/// Both clips are held-out takes.
+/// The output keeps the source's skeleton and frame rate and follows the
+/// source's path; a style clip with a slower stride (proud: about 1.7 s)
+/// makes the outputs of faster walks longer with elastic patches, with a
+/// period closer to the style's, but not with fixed ones. All clips are
+/// held-out takes. The timing is judged over every held-out dataset-1 walk
+/// at least 20% faster than the style clip, not on one pair: one short
+/// source's output period moves with the training seed (the happy walk,
+/// 4.5 s: 1.05 s, 2.23 s or not measurable for seeds 2, 3 and 1).
 #[test]
 fn restyled_walk_keeps_the_source_rig_and_takes_the_style_timing() {
-    let (Some(src), Some(sty)) = (
-        bandai("dataset-1", "dataset-1_walk_happy_002.bvh"),
-        bandai("dataset-1", "dataset-1_walk_proud_002.bvh"),
-    ) else {
+    const WALKS: [&str; 13] = [
+        "active",
+        "angry",
+        "childish",
+        "chimpira",
+        "feminine",
+        "giant",
+        "happy",
+        "masculinity",
+        "musical",
+        "not-confident",
+        "old",
+        "sad",
+        "tired",
+    ];
+    let Some(sty) = bandai("dataset-1", "dataset-1_walk_proud_002.bvh") else {
         return;
     };
     let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
-    let source = read_bvh(&src).unwrap();
     let style = read_bvh(&sty).unwrap();
     let mut t = StageTimings::default();
     let clip = prepare_style(&model, &style, "style", &mut t).unwrap();
-    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
-    let p_source = gait_period(&source, &rig).unwrap();
+    let rig = RigLayout::from_skeleton(style.skeleton()).unwrap();
     let p_style = gait_period(&style, &rig).unwrap();
-    assert!(
-        p_style > p_source * 1.2,
-        "elderly walk is slower: {p_style} vs {p_source}"
-    );
-
-    let elastic = restyle(
-        &model,
-        &source,
-        &[(&clip, 1.0)],
-        &ConvertOptions::default(),
-        t,
-    )
-    .unwrap();
-    let out = &elastic.motion;
-    assert_eq!(out.skeleton(), source.skeleton());
-    assert!((out.fps() - source.fps()).abs() < 1e-6);
-    assert!(out.values().iter().all(|v| v.is_finite()));
-    let scale = out.duration() / source.duration();
-    assert!(
-        scale > 1.05,
-        "elastic output should be slower, duration ratio {scale}"
-    );
-    // The path: start and end where the source starts and ends (horizontally).
-    let a = forward_kinematics(&source);
-    let b = forward_kinematics(out);
-    let hips = rig.pelvis;
-    for (fa, fb) in [(0, 0), (a.frame_count - 1, b.frame_count - 1)] {
-        let d = a.position(fa, hips) - b.position(fb, hips);
-        let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-        assert!(
-            horizontal < 5.0,
-            "pelvis {horizontal} cm off the source's path at frame {fb}"
-        );
-    }
-    let p_out = gait_period(out, &rig).unwrap();
-    assert!(
-        (p_out - p_style).abs() < (p_source - p_style).abs(),
-        "output period {p_out} s should be closer to the style's {p_style} s than the source's {p_source} s"
-    );
     let fixed = ConvertOptions {
         method: Method::FixedPatches,
         ..ConvertOptions::default()
     };
-    let fixed = restyle(&model, &source, &[(&clip, 1.0)], &fixed, t).unwrap();
-    assert_eq!(fixed.motion.frame_count(), source.frame_count());
+    let (mut scales, mut timed, mut closer) = (Vec::new(), 0, 0);
+    for name in WALKS {
+        let Some(src) = bandai("dataset-1", &format!("dataset-1_walk_{name}_002.bvh")) else {
+            return;
+        };
+        let source = read_bvh(&src).unwrap();
+        let out = restyle(
+            &model,
+            &source,
+            &[(&clip, 1.0)],
+            &ConvertOptions::default(),
+            t,
+        )
+        .unwrap()
+        .motion;
+        assert_eq!(out.skeleton(), source.skeleton());
+        assert!((out.fps() - source.fps()).abs() < 1e-6);
+        assert!(out.values().iter().all(|v| v.is_finite()));
+        // The path: start and end where the source starts and ends
+        // (horizontally).
+        let (a, b) = (forward_kinematics(&source), forward_kinematics(&out));
+        for (fa, fb) in [(0, 0), (a.frame_count - 1, b.frame_count - 1)] {
+            let d = a.position(fa, rig.pelvis) - b.position(fb, rig.pelvis);
+            let horizontal = (d.x * d.x + d.z * d.z).sqrt();
+            assert!(
+                horizontal < 5.0,
+                "{name}: pelvis {horizontal} cm off the source's path at frame {fb}"
+            );
+        }
+        let fixed_out = restyle(&model, &source, &[(&clip, 1.0)], &fixed, t).unwrap();
+        assert_eq!(fixed_out.motion.frame_count(), source.frame_count());
+        let p_source = gait_period(&source, &rig).unwrap();
+        if p_source > 0.8 * p_style {
+            continue; // not clearly faster than the style clip
+        }
+        scales.push(out.duration() / source.duration());
+        if let Some(p_out) = gait_period(&out, &rig) {
+            timed += 1;
+            closer += ((p_out - p_style).abs() < (p_source - p_style).abs()) as usize;
+        }
+    }
+    assert!(scales.len() >= 10, "{} faster walks", scales.len());
+    let mean_scale = scales.iter().sum::<f64>() / scales.len() as f64;
+    assert!(
+        mean_scale > 1.1,
+        "elastic outputs of faster walks should be longer: mean duration ratio {mean_scale}"
+    );
+    assert!(
+        closer as f64 >= 0.8 * timed as f64 && timed >= 8,
+        "output period closer to the style's in {closer} of {timed} measurable pairs"
+    );
 }
 
 /// Restyled to another take of its own style, a walk keeps its feet about
