@@ -407,7 +407,7 @@ const FIT_TOLERANCE_DEG: f32 = 3.0;
 ///   coordinate plane nearest the body's sagittal plane in the first frame
 ///   (the local axis nearest the direction from the right hip and shoulder
 ///   to the left ones, or the world `lateral` axis when the pairs give
-///   none), keeping its parent's
+///   none), keeping its parent's (for the root: the world's, `S`)
 ///   plane while that is within 60 degrees, so its frame is mirrored onto
 ///   itself. This is read from the motion because the all-zero rest pose of
 ///   some rigs is no human pose (Bandai's lays every bone along its local X
@@ -510,9 +510,10 @@ pub fn mirror_frames(
         let chosen = match (parent, lateral_in_joint[j]) {
             // A joint that cannot rotate must take its parent's frame.
             (Some(p), _) if keeps_rotation && allowed.iter().any(|&(c, _)| c == p) => p,
-            // The root's frame hangs from the world's: it keeps the world's
-            // reflection while that is near the body's sagittal plane, so its
-            // rotation is mirrored by conjugation, `S R S`.
+            // A midline joint keeps its parent's plane while that is near
+            // the body's sagittal plane. The root's parent is the world,
+            // reflected by `S`: a root that keeps `S` has its rotation
+            // mirrored by conjugation, `S R S`, as a still root stays still.
             (parent, Some(n)) if on_midline => midline_reflection(parent.or(Some(s)), n),
             (None, None) if fits(s) => s,
             (Some(p), _) if fits(p) => p,
