@@ -1,4 +1,4 @@
-//! Editing operations on motions: resample, trim, mirror, scale.
+//! Editing operations on motions: resample, trim, mirror, scale, turn.
 //!
 //! Every operation is a pure function: it reads a [`Motion`] and returns a
 //! new one, leaving the input untouched. Rotations are always handled as
@@ -185,6 +185,48 @@ pub fn scale(motion: &Motion, factor: f32) -> Motion {
     let skeleton = Skeleton::new(joints).expect("scaling keeps names, order and channels");
     Motion::new(skeleton, motion.frame_time(), motion.frame_count(), values)
         .expect("scaling keeps the shape of the values")
+}
+
+/// The take turned by `rotation` about the world origin (e.g. a turn about
+/// the vertical, to face the performer another way): every root's local
+/// rotation and translation (position channels, or the offset where it has
+/// none) are pre-multiplied by it, so every global position and rotation is
+/// turned and the rotations below the roots are kept. Fails when a root
+/// cannot hold any rotation (fewer than three rotation channels).
+pub fn turn(motion: &Motion, rotation: Quat) -> Result<Motion> {
+    let skeleton = motion.skeleton();
+    let roots: Vec<usize> = (0..skeleton.joint_count())
+        .filter(|&j| skeleton.joint(j).parent.is_none())
+        .collect();
+    let mut joints = skeleton.joints().to_vec();
+    for &r in &roots {
+        let root = &mut joints[r];
+        if root.euler_order().is_none() {
+            return Err(Error::Invalid(format!(
+                "cannot turn the take: its root {:?} has no three rotation channels",
+                root.name
+            )));
+        }
+        if !root.has_position_channels() {
+            root.offset = rotation * root.offset;
+        }
+    }
+    let skeleton = Skeleton::new(joints).expect("turning keeps names, order and channels");
+    let mut out = Motion::new(
+        skeleton,
+        motion.frame_time(),
+        motion.frame_count(),
+        motion.values().to_vec(),
+    )?;
+    for f in 0..motion.frame_count() {
+        for &r in &roots {
+            out.set_local_rotation(f, r, rotation * motion.local_rotation(f, r));
+            if motion.skeleton().joint(r).has_position_channels() {
+                out.set_local_translation(f, r, rotation * motion.local_translation(f, r));
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The world axis that points from the right hip to the left hip in the

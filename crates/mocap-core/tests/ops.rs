@@ -290,20 +290,38 @@ fn bandai_lateral_axis_is_x_and_frames_follow_the_rig() {
     }
 }
 
-/// The bundled Bandai walk with the performer turned by `degrees` about
-/// the vertical (the hips carry the heading; the root stays still).
-fn bundled_walk_turned(degrees: f32) -> Motion {
+fn bundled_walk() -> Motion {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../samples/dataset-1_walk_normal_001.bvh");
-    let mut m = read_bvh(&path).unwrap();
-    let hips = m.skeleton().find("Hips").unwrap();
-    let turn = Quat::from_rotation_y(degrees.to_radians());
-    for f in 0..m.frame_count() {
-        let (q, t) = (m.local_rotation(f, hips), m.local_translation(f, hips));
-        m.set_local_rotation(f, hips, turn * q);
-        m.set_local_translation(f, hips, turn * t);
+    read_bvh(&path).unwrap()
+}
+
+/// The bundled Bandai walk with the performer turned by `degrees` about
+/// the vertical.
+fn bundled_walk_turned(degrees: f32) -> Motion {
+    turn(&bundled_walk(), Quat::from_rotation_y(degrees.to_radians())).unwrap()
+}
+
+#[test]
+fn turn_turns_every_global_position_and_keeps_the_rotations_below_the_root() {
+    let m = bundled_walk();
+    let rotation = Quat::from_rotation_y(1.2);
+    let turned = turn(&m, rotation).unwrap();
+    let (p, q) = (forward_kinematics(&m), forward_kinematics(&turned));
+    for (a, b) in p.positions.iter().zip(&q.positions) {
+        assert!((rotation * *a).distance(*b) < 1e-2, "{a} turned is not {b}");
     }
-    m
+    let hips = m.skeleton().find("Hips").unwrap();
+    for f in 0..m.frame_count() {
+        let (a, b) = (m.local_rotation(f, hips), turned.local_rotation(f, hips));
+        assert!(same_rotation(a, b, 1e-3), "frame {f}");
+    }
+    // A root that cannot rotate cannot be turned.
+    let mut root = Joint::new("Root", None, Vec3::ZERO);
+    root.channels = POSITIONS.to_vec();
+    let still = Motion::new(Skeleton::new(vec![root]).unwrap(), 0.1, 1, vec![0.0; 3]).unwrap();
+    let err = turn(&still, rotation).unwrap_err().to_string();
+    assert!(err.contains("no three rotation channels"), "{err}");
 }
 
 #[test]
