@@ -48,10 +48,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         i += 2;
     }
     let data = data.ok_or("--data FOLDER is required")?;
+    // What a user waits for before the first frame: reading the model and
+    // building its filter's bases.
+    let start = Instant::now();
     let model = match &model_path {
         Some(p) => ModelFile::load(p, device)?,
         None => ModelFile::Network(Box::new(CleanModel::load_default(device)?)),
     };
+    let load_seconds = start.elapsed().as_secs_f64();
     // A long clip: takes joined end to end on the first take's skeleton.
     let paths = list_bvh(std::slice::from_ref(&data))?;
     let first = read_bvh(&paths[0])?;
@@ -73,7 +77,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         values.len() / c,
         values,
     )?;
+    let start = Instant::now();
     model.clean(&clip, None)?; // warm-up
+    println!(
+        "load: {load_seconds:.3} s; first clean (a mixture builds its chosen component's bases): {:.3} s",
+        start.elapsed().as_secs_f64()
+    );
     let start = Instant::now();
     for _ in 0..repeats {
         model.clean(&clip, None)?;

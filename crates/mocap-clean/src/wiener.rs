@@ -63,6 +63,12 @@
 //! length times the number of components; the level is then estimated on
 //! every segment with the chosen component.
 //!
+//! Choosing needs every component's bases of (2), but filtering only the
+//! chosen one's bases of (1), the larger share of the work (a full-size
+//! eigendecomposition and products per bin): those are built when a
+//! component is first chosen, so loading a 13-component mixture takes about
+//! a second instead of seven (`bench/clean/speed.txt`).
+//!
 //! ## Limits
 //!
 //! It is linear: spikes (another motion pasted on a subtree) are smeared,
@@ -71,7 +77,7 @@
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use burn::module::{Module, Param};
@@ -174,18 +180,40 @@ struct Bin {
     from_white: DMatrix<C64>,
     /// Eigenvalues of the whitened signal spectrum (>= 0).
     lambda: Vec<f64>,
-    /// The same decomposition restricted to the directions the noise model
-    /// puts noise in (no ridge), for estimating the noise level (2):
-    /// `V'^H D^-1/2 Q^T` with `N = Q D Q^T` over those directions.
+}
+
+/// One frequency bin of the same decomposition restricted to the
+/// directions the noise model puts noise in (no ridge), for estimating the
+/// noise level (2): `V'^H D^-1/2 Q^T` with `N = Q D Q^T` over those
+/// directions.
+#[derive(Debug, Clone)]
+struct LevelBin {
     noisy_to_white: DMatrix<C64>,
     noisy_lambda: Vec<f64>,
 }
 
-/// The spectra of one kind of motion and the bases of (1) built from them.
+/// The spectra of one kind of motion and the bases of (1) and (2) built
+/// from them. Every component's bases for (2) are needed to choose among
+/// them, but only the chosen one's bases for (1), the larger part of the
+/// work (a full-size eigendecomposition and products per bin): they are
+/// built the first time the component is chosen, so that loading a
+/// mixture stays quick.
 #[derive(Debug, Clone)]
 struct Component {
     spectra: Vec<DMatrix<C64>>,
-    bins: Vec<Bin>,
+    level_bins: Vec<LevelBin>,
+    bins: OnceLock<Vec<Bin>>,
+}
+
+/// `N`'s square root and inverse square root (with the ridge) and the
+/// whitening of its noisy directions: what turns a component's spectra
+/// into its bases. Shared by all components, since they share `N`.
+#[derive(Debug, Clone)]
+struct Whitening {
+    half: DMatrix<f64>,
+    inverse_half: DMatrix<f64>,
+    /// `D^-1/2 Q^T` over the directions with noise (rows).
+    noisy: DMatrix<f64>,
 }
 
 /// A fitted filter (see the module docs).
@@ -196,6 +224,7 @@ pub struct WienerFilter {
     /// the same `N`.
     components: Vec<Component>,
     noise: DMatrix<f64>,
+    whitening: Arc<Whitening>,
 }
 
 /// What filtering a take did.
@@ -216,6 +245,32 @@ fn noise_ridge(noise: &DMatrix<f64>) -> f64 {
 }
 
 /// Periodic Hann window of `len` frames at `t`.
+/// The eigendecomposition of a matrix Hermitian up to rounding
+/// (symmetrised before the solver).
+fn hermitian_eigen(m: DMatrix<C64>) -> SymmetricEigen<C64, nalgebra::Dyn> {
+    SymmetricEigen::new((&m + m.adjoint()) * C64::new(0.5, 0.0))
+}
+
+/// `W S W^T` for a real `W` and a complex `S`: a spectrum seen through a
+/// whitening.
+fn whiten(w: &DMatrix<f64>, s: &DMatrix<C64>) -> DMatrix<C64> {
+    complex_times_real(&real_times_complex(w, s), &w.transpose())
+}
+
+/// `a b` for a real `a`: as two real products, which nalgebra hands to a
+/// blocked matrix product (complex products run element by element, ten
+/// times slower at these sizes, and most of a mixture's loading time).
+fn real_times_complex(a: &DMatrix<f64>, b: &DMatrix<C64>) -> DMatrix<C64> {
+    let (re, im) = (a * b.map(|z| z.re), a * b.map(|z| z.im));
+    re.zip_map(&im, C64::new)
+}
+
+/// `a b` for a real `b` (see [`real_times_complex`]).
+fn complex_times_real(a: &DMatrix<C64>, b: &DMatrix<f64>) -> DMatrix<C64> {
+    let (re, im) = (a.map(|z| z.re) * b, a.map(|z| z.im) * b);
+    re.zip_map(&im, C64::new)
+}
+
 fn hann(t: usize, len: usize) -> f64 {
     0.5 - 0.5 * (2.0 * PI * t as f64 / len as f64).cos()
 }
@@ -534,6 +589,7 @@ impl WienerFilter {
             description,
             components,
             noise,
+            whitening: first.whitening.clone(),
         })
     }
 
@@ -548,7 +604,8 @@ impl WienerFilter {
             && self.noise == other.noise
     }
 
-    /// Builds the per-bin bases of (1) from each component's spectra and `N`.
+    /// Builds the per-bin bases of (2) from each component's spectra and `N`
+    /// (those of (1) wait until a component is used: [`Self::bins`]).
     fn from_parts(
         description: WienerDescription,
         spectra_sets: Vec<Vec<DMatrix<C64>>>,
@@ -563,9 +620,8 @@ impl WienerFilter {
             let d = DMatrix::from_diagonal(
                 &eigen.eigenvalues.map(|v| (v.max(0.0) + ridge).powf(power)),
             );
-            (&eigen.eigenvectors * d * eigen.eigenvectors.transpose()).map(|v| C64::new(v, 0.0))
+            &eigen.eigenvectors * d * eigen.eigenvectors.transpose()
         };
-        let (half, inverse_half) = (root(0.5), root(-0.5));
         // The noise level is estimated only in the directions the noise model
         // puts noise in: in the others the whitening has nothing but the
         // ridge to divide by, and any power the training spectra did not
@@ -574,44 +630,72 @@ impl WienerFilter {
         let noisy: Vec<usize> = (0..c)
             .filter(|&i| eigen.eigenvalues[i] > 1e-6 * largest && largest > 0.0)
             .collect();
-        let noisy_whitening = DMatrix::from_fn(noisy.len(), c, |k, j| {
-            let i = noisy[k];
-            C64::new(
-                eigen.eigenvectors[(j, i)] / eigen.eigenvalues[i].sqrt(),
-                0.0,
-            )
-        });
-        let hermitian_eigen = |m: DMatrix<C64>| {
-            // Hermitian up to rounding; symmetrise before the solver.
-            SymmetricEigen::new((&m + m.adjoint()) * C64::new(0.5, 0.0))
+        let whitening = Whitening {
+            half: root(0.5),
+            inverse_half: root(-0.5),
+            noisy: DMatrix::from_fn(noisy.len(), c, |k, j| {
+                let i = noisy[k];
+                eigen.eigenvectors[(j, i)] / eigen.eigenvalues[i].sqrt()
+            }),
         };
-        let component = |spectra: Vec<DMatrix<C64>>| -> Component {
-            let bins = spectra
-                .par_iter()
-                .map(|s| {
-                    let eigen = hermitian_eigen(&inverse_half * s * &inverse_half);
-                    let noisy_white =
-                        hermitian_eigen(&noisy_whitening * s * noisy_whitening.adjoint());
-                    Bin {
-                        to_white: eigen.eigenvectors.adjoint() * &inverse_half,
-                        from_white: &half * &eigen.eigenvectors,
-                        lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
-                        noisy_to_white: noisy_white.eigenvectors.adjoint() * &noisy_whitening,
-                        noisy_lambda: noisy_white
-                            .eigenvalues
-                            .iter()
-                            .map(|&l| l.max(0.0))
-                            .collect(),
-                    }
-                })
-                .collect();
-            Component { spectra, bins }
-        };
+        let components = spectra_sets
+            .into_iter()
+            .map(|spectra| {
+                let level_bins = spectra
+                    .par_iter()
+                    .map(|s| {
+                        let noisy_white = hermitian_eigen(whiten(&whitening.noisy, s));
+                        LevelBin {
+                            noisy_to_white: complex_times_real(
+                                &noisy_white.eigenvectors.adjoint(),
+                                &whitening.noisy,
+                            ),
+                            noisy_lambda: noisy_white
+                                .eigenvalues
+                                .iter()
+                                .map(|&l| l.max(0.0))
+                                .collect(),
+                        }
+                    })
+                    .collect();
+                Component {
+                    spectra,
+                    level_bins,
+                    bins: OnceLock::new(),
+                }
+            })
+            .collect();
         WienerFilter {
             description,
-            components: spectra_sets.into_iter().map(component).collect(),
+            components,
             noise,
+            whitening: Arc::new(whitening),
         }
+    }
+
+    /// The bases of (1) of `component`, built on first use. Built on one
+    /// thread: takes are often filtered in parallel (rayon), and a rayon
+    /// thread building them in parallel could, while it waits, pick up
+    /// another take's filtering, which would wait on the same cell.
+    fn bins<'a>(&self, component: &'a Component) -> &'a [Bin] {
+        component.bins.get_or_init(|| {
+            let w = &self.whitening;
+            component
+                .spectra
+                .iter()
+                .map(|s| {
+                    let eigen = hermitian_eigen(whiten(&w.inverse_half, s));
+                    Bin {
+                        to_white: complex_times_real(
+                            &eigen.eigenvectors.adjoint(),
+                            &w.inverse_half,
+                        ),
+                        from_white: real_times_complex(&w.half, &eigen.eigenvectors),
+                        lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                    }
+                })
+                .collect()
+        })
     }
 
     /// The features of `motion`'s rig, or an error naming both rigs.
@@ -747,6 +831,7 @@ impl WienerFilter {
             }
         };
         let component = &self.components[k];
+        let bins = self.bins(component);
         let s = (sigma / self.description.noise_sigma_deg as f64).powi(2);
         let padded_missing = missing.map(|m| reflect_pad(&m[..frames * c], c, len));
         // For (3): S(f) + s N per bin, the same for every segment.
@@ -770,8 +855,8 @@ impl WienerFilter {
                     return transforms
                         .inverse_segment(&self.conditional_mean(component, x, &totals, &gone));
                 }
-                let mut spectrum = DMatrix::<C64>::zeros(c, component.bins.len());
-                for (b, bin) in component.bins.iter().enumerate() {
+                let mut spectrum = DMatrix::<C64>::zeros(c, bins.len());
+                for (b, bin) in bins.iter().enumerate() {
                     let z = &bin.to_white * x.column(b);
                     let gained = DVector::from_iterator(
                         c,
@@ -836,7 +921,7 @@ impl WienerFilter {
     ) -> DMatrix<C64> {
         let c = self.description.channels;
         let ridge = noise_ridge(&self.noise);
-        let mut out = DMatrix::<C64>::zeros(c, component.bins.len());
+        let mut out = DMatrix::<C64>::zeros(c, component.spectra.len());
         for (b, (spectrum, total)) in component.spectra.iter().zip(totals).enumerate() {
             // Far above any channel's power: the channel's value is noise.
             let unknown = 1e6 * (spectrum.trace().re / c as f64 + ridge);
@@ -869,7 +954,7 @@ impl WienerFilter {
         // Power per bin and coordinate, summed over segments.
         let empty = || -> Vec<Vec<f64>> {
             component
-                .bins
+                .level_bins
                 .iter()
                 .map(|bin| vec![0.0; bin.noisy_lambda.len()])
                 .collect()
@@ -877,7 +962,7 @@ impl WienerFilter {
         let power = spectra
             .par_iter()
             .fold(empty, |mut power, x| {
-                for (b, (p, bin)) in power.iter_mut().zip(&component.bins).enumerate() {
+                for (b, (p, bin)) in power.iter_mut().zip(&component.level_bins).enumerate() {
                     let z = &bin.noisy_to_white * x.column(b);
                     for (pi, v) in p.iter_mut().zip(z.iter()) {
                         *pi += v.norm_sqr() / norm;
@@ -896,7 +981,7 @@ impl WienerFilter {
         let n = spectra.len() as f64;
         let log_likelihood = |s: f64| -> f64 {
             let mut total = 0.0;
-            for (b, (bin, p)) in component.bins.iter().zip(&power).enumerate() {
+            for (b, (bin, p)) in component.level_bins.iter().zip(&power).enumerate() {
                 let weight = if b == 0 || 2 * b == len { 0.5 } else { 1.0 };
                 let mut sum = 0.0;
                 for (&l, &pi) in bin.noisy_lambda.iter().zip(p) {
@@ -1347,15 +1432,37 @@ mod tests {
     }
 
     #[test]
+    fn real_by_complex_products_match_the_complex_product() {
+        let real = DMatrix::from_fn(5, 7, |i, j| ((i * 7 + j) as f64 * 0.37).sin());
+        let complex = DMatrix::from_fn(7, 4, |i, j| {
+            C64::new((i as f64 - j as f64) * 0.3, ((i * j) as f64).cos())
+        });
+        let as_complex = |m: &DMatrix<f64>| m.map(|v| C64::new(v, 0.0));
+        let expected = &as_complex(&real) * &complex;
+        assert!((real_times_complex(&real, &complex) - &expected).norm() < 1e-12);
+        let expected = &complex.adjoint() * &as_complex(&real.transpose());
+        let got = complex_times_real(&complex.adjoint(), &real.transpose());
+        assert!((got - &expected).norm() < 1e-12);
+        // W S W^T, a spectrum seen through a whitening.
+        let s = DMatrix::from_fn(7, 7, |i, j| C64::new((i + j) as f64, i as f64 - j as f64));
+        let expected = &as_complex(&real) * &s * as_complex(&real.transpose());
+        assert!((whiten(&real, &s) - expected).norm() < 1e-9);
+    }
+
+    #[test]
     fn the_short_time_transform_gives_back_its_input() {
         // With every gain 1 the analysis, synthesis and overlap-add must
         // return the features, for takes shorter and longer than a segment.
         let c = 6;
-        let bins = (0..17)
+        let bins: Vec<Bin> = (0..17)
             .map(|_| Bin {
                 to_white: DMatrix::identity(c, c),
                 from_white: DMatrix::identity(c, c),
                 lambda: vec![1e30; c],
+            })
+            .collect();
+        let level_bins = (0..17)
+            .map(|_| LevelBin {
                 noisy_to_white: DMatrix::identity(c, c),
                 noisy_lambda: vec![1e30; c],
             })
@@ -1377,9 +1484,15 @@ mod tests {
             },
             components: vec![Component {
                 spectra: Vec::new(),
-                bins,
+                level_bins,
+                bins: OnceLock::from(bins),
             }],
             noise: DMatrix::zeros(c, c),
+            whitening: Arc::new(Whitening {
+                half: DMatrix::identity(c, c),
+                inverse_half: DMatrix::identity(c, c),
+                noisy: DMatrix::identity(c, c),
+            }),
         };
         for frames in [0, 1, 5, 31, 32, 33, 100] {
             let x: Vec<f32> = (0..frames * c)
