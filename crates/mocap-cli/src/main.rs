@@ -20,6 +20,11 @@ struct Cli {
     /// Print nothing but results and errors (no progress bars, no notes).
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// A rig the built-in tables do not know: a TOML file naming its joints
+    /// (`[parts] pelvis = "Becken"`...; format: `mocap_core::bodymap`). Used
+    /// for every skeleton that has the joints it names; may be repeated.
+    #[arg(long, global = true, value_name = "FILE")]
+    rig: Vec<std::path::PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
@@ -66,6 +71,12 @@ fn main() -> ExitCode {
     }
     // The libraries' own progress bars (training) obey --quiet too.
     mocap_nn::train::hide_progress(cli.quiet);
+    for rig in &cli.rig {
+        if let Err(error) = mocap_core::bodymap::register_rig_file(rig) {
+            eprintln!("error: {error:#}");
+            return ExitCode::from(1);
+        }
+    }
     let result = match cli.command {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),

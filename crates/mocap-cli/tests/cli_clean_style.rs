@@ -665,3 +665,88 @@ fn style_clips_and_sources_of_other_rigs_are_retargeted() {
     );
     assert!(!output.exists());
 }
+
+#[test]
+fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
+    // The bundled walk with every joint renamed: no built-in rig table
+    // knows the names, a rig file says which joint is which.
+    let dir = tempfile::tempdir().unwrap();
+    let renamed = dir.path().join("renamed.bvh");
+    let walk = mocap_testdata::sample_walk();
+    std::fs::write(&renamed, mocap_testdata::renamed_bandai_bvh(&walk)).unwrap();
+    let rig = dir.path().join("studio.toml");
+    std::fs::write(&rig, mocap_testdata::RENAMED_BANDAI_RIG).unwrap();
+    let (renamed, rig, walk) = (path(&renamed), path(&rig), walk.display().to_string());
+    let proud = sample("dataset-1_walk_proud_001.bvh");
+
+    // Without the file: what needs body parts says how to give them.
+    let out = mocap(&["info", renamed]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--rig FILE"));
+    let restyled_renamed = dir.path().join("restyled-renamed.bvh");
+    let apply = |rig: Option<&str>, source: &str, out: &Path| {
+        let mut args = Vec::from_iter(rig.map(|r| ["--rig", r]).into_iter().flatten());
+        args.extend(["style", "apply", source, "--style", &proud, "-o", path(out)]);
+        mocap(&args)
+    };
+    let out = apply(None, renamed, &restyled_renamed);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("--rig FILE"), "{}", stderr(&out));
+    assert!(!restyled_renamed.exists());
+
+    // With it: the rig is found, and search and style give what they give
+    // on the original names.
+    let out = mocap(&["--rig", rig, "info", "--json", renamed]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info[0]["rig"], "Studio (German names)");
+    assert_eq!(info[0]["body_parts"].as_array().unwrap().len(), 21);
+
+    let index = mocap_testdata::repo_root().join("models/search-bandai-content.idx");
+    let query = |args: &[&str]| -> serde_json::Value {
+        let out = mocap(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v.as_object_mut().unwrap().remove("query");
+        v
+    };
+    let index = path(&index);
+    let plain = query(&["search", "query", &walk, "--index", index, "--json"]);
+    let with_rig = query(&[
+        "--rig", rig, "search", "query", renamed, "--index", index, "--json",
+    ]);
+    assert_eq!(plain, with_rig);
+
+    let out = apply(Some(rig), renamed, &restyled_renamed);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let restyled = dir.path().join("restyled.bvh");
+    let out = apply(None, &walk, &restyled);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (
+        read_bvh(&restyled).unwrap(),
+        read_bvh(&restyled_renamed).unwrap(),
+    );
+    assert_eq!(a.frame_count(), b.frame_count());
+    assert_eq!(b.skeleton().joint(1).name, "Becken");
+    let (pa, pb) = (
+        mocap_core::forward_kinematics(&a),
+        mocap_core::forward_kinematics(&b),
+    );
+    for f in 0..a.frame_count() {
+        for j in 0..a.skeleton().joint_count() {
+            let d = pa.position(f, j).distance(pb.position(f, j));
+            assert!(d < 0.01, "frame {f}, joint {j}: {d} cm apart");
+        }
+    }
+
+    // A rig file with a mistake stops the command before it starts.
+    let typo = dir.path().join("typo.toml");
+    std::fs::write(&typo, "[parts]\npelvis = \"Becken\"\nhead = Kopf\n").unwrap();
+    let out = mocap(&["--rig", path(&typo), "info", renamed]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("typo.toml") && stderr(&out).contains(":3:"),
+        "{}",
+        stderr(&out)
+    );
+}

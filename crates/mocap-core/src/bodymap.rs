@@ -48,10 +48,17 @@
 //! [mirror]                     # optional extra left/right joint pairs
 //! pairs = [["L_Finger1", "R_Finger1"]]
 //! ```
+//!
+//! Such a file is read for one skeleton with [`BodyMap::from_toml_file`], or
+//! given to the whole process with [`register_rig_file`] (what `mocap --rig
+//! FILE` does), so that every [`BodyMap::detect`] (search features, style
+//! transfer, retargeting, mirroring...) uses it for the skeletons that have
+//! the joints it names.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::RwLock;
 
 use crate::error::{Error, Location, ParseError, Result};
 use crate::skeleton::Skeleton;
@@ -408,7 +415,16 @@ impl BodyMap {
     /// the one that locates the most parts. Fails, naming the missing parts
     /// and the names tried, when no rig locates every required part
     /// ([`BodyPart::is_required`]).
+    ///
+    /// Rig files given with [`register_rig_file`] come first: the first
+    /// whose joints the skeleton all has is used (with its own errors, e.g.
+    /// a required part still missing).
     pub fn detect(skeleton: &Skeleton) -> Result<BodyMap> {
+        let registered = REGISTERED_RIGS.read().unwrap_or_else(|e| e.into_inner());
+        if let Some(rig) = registered.iter().find(|rig| rig.fits(skeleton)) {
+            return BodyMap::from_rig_file(&rig.file, &rig.path, skeleton);
+        }
+        drop(registered);
         let names = NameIndex::new(skeleton);
         let (rig, map) = best_rig(&names);
         let missing: Vec<BodyPart> = map
@@ -426,7 +442,8 @@ impl BodyMap {
         Err(Error::Invalid(format!(
             "cannot find the body parts of this skeleton ({} joints: {}): the closest \
              built-in rig, {}, lacks {}; describe the rig in a TOML file \
-             ([parts] {} = \"joint name\") and load it with BodyMap::from_toml_file",
+             ([parts] {} = \"joint name\") and give it with `mocap --rig FILE` \
+             (in code: register_rig_file or BodyMap::from_toml_file)",
             skeleton.joint_count(),
             joint_list(skeleton),
             rig.name,
@@ -476,32 +493,19 @@ impl BodyMap {
     }
 
     fn from_toml_at(text: &str, path: &Path, skeleton: &Skeleton) -> Result<BodyMap> {
-        let file: RigFile = toml::from_str(text).map_err(|e| {
-            let (line, column) = match e.span() {
-                Some(span) => line_column(text, span.start),
-                None => (1, 1),
-            };
-            ParseError {
-                location: Location {
-                    path: path.to_path_buf(),
-                    line,
-                    column,
-                },
-                message: format!("rig file: {}", e.message()),
-            }
-        })?;
+        BodyMap::from_rig_file(&RigFile::parse(text, path)?, path, skeleton)
+    }
+
+    fn from_rig_file(file: &RigFile, path: &Path, skeleton: &Skeleton) -> Result<BodyMap> {
         let where_ = path.display();
         let names = NameIndex::new(skeleton);
         let (_, mut map) = best_rig(&names);
-        map.rig = file.name.unwrap_or_else(|| path.display().to_string());
+        map.rig = file
+            .name
+            .clone()
+            .unwrap_or_else(|| path.display().to_string());
         for (key, joint_name) in &file.parts {
-            let part = BodyPart::from_key(key).ok_or_else(|| {
-                let keys: Vec<&str> = BodyPart::ALL.iter().map(|p| p.key()).collect();
-                Error::Invalid(format!(
-                    "{where_}: [parts] has unknown part {key:?}; the parts are {}",
-                    keys.join(", ")
-                ))
-            })?;
+            let part = BodyPart::from_key(key).expect("part keys are checked when parsed");
             let joint = find_joint(skeleton, joint_name).ok_or_else(|| {
                 Error::Invalid(format!(
                     "{where_}: [parts] {key} = {joint_name:?}, but the skeleton has no such \
@@ -511,7 +515,7 @@ impl BodyMap {
             })?;
             map.joints[part.index()] = Some(joint);
         }
-        if let Some(mirror) = file.mirror {
+        if let Some(mirror) = &file.mirror {
             for [left, right] in &mirror.pairs {
                 let find = |name: &String| {
                     find_joint(skeleton, name).ok_or_else(|| {
@@ -825,4 +829,88 @@ struct RigFile {
 #[serde(deny_unknown_fields)]
 struct MirrorSection {
     pairs: Vec<[String; 2]>,
+}
+
+impl RigFile {
+    /// Parses a rig file and checks its part keys; errors name `path`,
+    /// with line and column for TOML syntax.
+    fn parse(text: &str, path: &Path) -> Result<RigFile> {
+        let file: RigFile = toml::from_str(text).map_err(|e| {
+            let (line, column) = match e.span() {
+                Some(span) => line_column(text, span.start),
+                None => (1, 1),
+            };
+            ParseError {
+                location: Location {
+                    path: path.to_path_buf(),
+                    line,
+                    column,
+                },
+                message: format!("rig file: {}", e.message()),
+            }
+        })?;
+        if let Some(key) = file.parts.keys().find(|k| BodyPart::from_key(k).is_none()) {
+            let keys: Vec<&str> = BodyPart::ALL.iter().map(|p| p.key()).collect();
+            return Err(Error::Invalid(format!(
+                "{}: [parts] has unknown part {key:?}; the parts are {}",
+                path.display(),
+                keys.join(", ")
+            )));
+        }
+        Ok(file)
+    }
+
+    /// Every joint name the file gives (parts and mirror pairs).
+    fn joint_names(&self) -> impl Iterator<Item = &String> {
+        self.parts
+            .values()
+            .chain(self.mirror.iter().flat_map(|m| m.pairs.iter().flatten()))
+    }
+}
+
+/// A rig file given to the whole process ([`register_rig_file`]).
+struct RegisteredRig {
+    path: PathBuf,
+    file: RigFile,
+}
+
+impl RegisteredRig {
+    /// Whether `skeleton` has every joint the file names (a file with no
+    /// names fits nothing: it would take over every skeleton).
+    fn fits(&self, skeleton: &Skeleton) -> bool {
+        let mut names = self.file.joint_names().peekable();
+        names.peek().is_some() && names.all(|n| find_joint(skeleton, n).is_some())
+    }
+}
+
+/// Rig files [`BodyMap::detect`] tries before the built-in rigs, in the
+/// order they were given.
+static REGISTERED_RIGS: RwLock<Vec<RegisteredRig>> = RwLock::new(Vec::new());
+
+/// Reads a rig file (format in the module documentation) and makes every
+/// later [`BodyMap::detect`] in this process use it for the skeletons that
+/// have all the joints it names (files given earlier are tried first).
+/// This is how a rig the built-in tables do not know reaches every
+/// capability (`mocap --rig FILE`). Fails, naming the file (and line and
+/// column for TOML syntax), on a file that cannot be read or parsed, an
+/// unknown part key, or a file that names no joint.
+pub fn register_rig_file(path: impl AsRef<Path>) -> Result<()> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let file = RigFile::parse(&text, path)?;
+    if file.joint_names().next().is_none() {
+        return Err(Error::Invalid(format!(
+            "{}: the rig file names no joint: list the rig's joints under [parts] \
+             (e.g. pelvis = \"Hips\")",
+            path.display()
+        )));
+    }
+    REGISTERED_RIGS
+        .write()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(RegisteredRig {
+            path: path.to_path_buf(),
+            file,
+        });
+    Ok(())
 }

@@ -33,7 +33,9 @@
 //! two references gives the motion back exactly. Two rigs with the same
 //! joints (names, hierarchy and bone directions; other bone lengths, as two
 //! performers of one capture setup) need no convention: every joint keeps
-//! its local rotation. Parts with no part below
+//! its local rotation. Joints of other names count as the same when both
+//! body maps put every part at the same joint (one rig under two naming
+//! schemes, one of them described by a rig file). Parts with no part below
 //! them (head, hands, toes, or a wrist where one rig has no hand) borrow the
 //! frame correction `F_s F_t^-1` of the part above them.
 //!
@@ -316,12 +318,22 @@ impl Retargeting {
                 || (a == Vec3::ZERO && b == Vec3::ZERO)
                 || a.dot(b) > 5.0f32.to_radians().cos()
         };
+        // Joints are counterparts by name, or, for one rig under two
+        // naming schemes (a rig file says what each name is), where both
+        // body maps put every part at the same joint.
+        let same_names = source
+            .joints()
+            .iter()
+            .zip(target.joints())
+            .all(|(a, b)| a.name == b.name);
+        let same_parts = source_map.parts().eq(target_map.parts());
         let same_joints = source.joint_count() == n
             && source
                 .joints()
                 .iter()
                 .zip(target.joints())
-                .all(|(a, b)| a.name == b.name && a.parent == b.parent)
+                .all(|(a, b)| a.parent == b.parent)
+            && (same_names || same_parts)
             && (0..n).all(same_axes);
         let roles = if same_joints {
             (0..n)

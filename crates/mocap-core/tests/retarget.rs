@@ -262,6 +262,29 @@ fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
 }
 
 #[test]
+fn one_rig_under_two_naming_schemes_keeps_every_local_rotation() {
+    // The same rig with every joint renamed (a rig file says which is
+    // which), its reference a different clip whose first frame is another
+    // pose: joints are counterparts by body part, not by name, so there is
+    // no reference-pose convention to turn a forearm or the spine.
+    let take = read_bvh(&sample_walk()).unwrap();
+    let other_path = mocap_testdata::sample("dataset-1_walk_proud_001.bvh");
+    let text = mocap_testdata::renamed_bandai_bvh(&other_path);
+    let other =
+        mocap_core::io::bvh::read_bvh_from(std::io::Cursor::new(text), &other_path).unwrap();
+    let other_map =
+        BodyMap::from_toml_str(mocap_testdata::RENAMED_BANDAI_RIG, other.skeleton()).unwrap();
+    let take_map = BodyMap::detect(take.skeleton()).unwrap();
+    let moved = Retargeting::new(&take, &take_map, &other, &other_map)
+        .unwrap()
+        .apply(&take)
+        .unwrap();
+    assert_eq!(moved.skeleton(), other.skeleton());
+    let errors = joint_rotation_errors_degrees(&take, &moved).unwrap();
+    assert!(errors.iter().all(|&e| e < 0.01), "{errors:?}");
+}
+
+#[test]
 fn a_turned_helper_root_still_puts_the_pelvis_where_the_source_has_it() {
     // The bundled walk with its helper root (`joint_Root`, above the pelvis)
     // turned a quarter about the vertical: the same joints, so the root's

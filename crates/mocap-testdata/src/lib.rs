@@ -57,3 +57,81 @@ pub fn bvh_files(dir: &Path) -> Vec<PathBuf> {
     files.sort();
     files
 }
+
+/// The Bandai rig's joints under another naming scheme (German names, as a
+/// studio's own convention might have them), which no built-in rig table
+/// knows: `(Bandai name, other name)`.
+pub const RENAMED_BANDAI_JOINTS: [(&str, &str); 22] = [
+    ("joint_Root", "Wurzel"),
+    ("Hips", "Becken"),
+    ("Spine", "Wirbel"),
+    ("Chest", "Brust"),
+    ("Neck", "Hals"),
+    ("Head", "Kopf"),
+    ("Shoulder_L", "Schluesselbein_li"),
+    ("UpperArm_L", "Oberarm_li"),
+    ("LowerArm_L", "Unterarm_li"),
+    ("Hand_L", "Handgelenk_li"),
+    ("Shoulder_R", "Schluesselbein_re"),
+    ("UpperArm_R", "Oberarm_re"),
+    ("LowerArm_R", "Unterarm_re"),
+    ("Hand_R", "Handgelenk_re"),
+    ("UpperLeg_L", "Oberschenkel_li"),
+    ("LowerLeg_L", "Unterschenkel_li"),
+    ("Foot_L", "Knoechel_li"),
+    ("Toes_L", "Zehen_li"),
+    ("UpperLeg_R", "Oberschenkel_re"),
+    ("LowerLeg_R", "Unterschenkel_re"),
+    ("Foot_R", "Knoechel_re"),
+    ("Toes_R", "Zehen_re"),
+];
+
+/// A rig file (`mocap_core::bodymap`'s format) for [`RENAMED_BANDAI_JOINTS`].
+pub const RENAMED_BANDAI_RIG: &str = r#"name = "Studio (German names)"
+[parts]
+pelvis = "Becken"
+spine = "Wirbel"
+chest = "Brust"
+neck = "Hals"
+head = "Kopf"
+left_clavicle = "Schluesselbein_li"
+left_shoulder = "Oberarm_li"
+left_elbow = "Unterarm_li"
+left_wrist = "Handgelenk_li"
+right_clavicle = "Schluesselbein_re"
+right_shoulder = "Oberarm_re"
+right_elbow = "Unterarm_re"
+right_wrist = "Handgelenk_re"
+left_hip = "Oberschenkel_li"
+left_knee = "Unterschenkel_li"
+left_ankle = "Knoechel_li"
+left_toe = "Zehen_li"
+right_hip = "Oberschenkel_re"
+right_knee = "Unterschenkel_re"
+right_ankle = "Knoechel_re"
+right_toe = "Zehen_re"
+"#;
+
+/// The text of a Bandai BVH file with its joints renamed by
+/// [`RENAMED_BANDAI_JOINTS`] (the motion is unchanged).
+pub fn renamed_bandai_bvh(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let renamed: Vec<String> = text
+        .lines()
+        .map(|line| {
+            let trimmed = line.trim_start();
+            for keyword in ["ROOT ", "JOINT "] {
+                if let Some(name) = trimmed.strip_prefix(keyword) {
+                    let name = name.trim();
+                    if let Some((_, other)) = RENAMED_BANDAI_JOINTS.iter().find(|(b, _)| *b == name)
+                    {
+                        let indent = &line[..line.len() - trimmed.len()];
+                        return format!("{indent}{keyword}{other}");
+                    }
+                }
+            }
+            line.to_string()
+        })
+        .collect();
+    renamed.join("\n") + "\n"
+}

@@ -112,8 +112,9 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 BodyPart::COUNT
             ),
             None => println!(
-                "  rig        body parts not found (retargeting and restyling need a rig file: \
-                 see mocap_core::bodymap)"
+                "  rig        body parts not found (search, restyling and retargeting need them: \
+                 describe the rig in a file and give it with --rig FILE, format in \
+                 mocap_core::bodymap)"
             ),
         }
     }
