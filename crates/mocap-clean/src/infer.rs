@@ -169,6 +169,33 @@ impl CleanModel {
                 self.description.network.channels,
             )));
         }
+        // As many joints is not the same rig: the network reads each
+        // joint's features in its place, so they must be the same joints
+        // in the same order.
+        let names: Vec<&str> = layout
+            .joints
+            .iter()
+            .map(|&j| motion.skeleton().joint(j).name.as_str())
+            .collect();
+        let known = &self.description.joints;
+        if let Some(k) =
+            (0..names.len()).find(|&k| known.get(k).map(String::as_str) != Some(names[k]))
+        {
+            return Err(CleanError::Invalid(format!(
+                "the model was trained on a rig of {} joints with rotations ({}, ...), this take's \
+                 {} joints with rotations are others: joint {} is {:?} where the model has {:?}. \
+                 Clean it with --filter butterworth-gcv:2, play it by the model's rig first \
+                 (`mocap convert IN OUT --retarget-to samples/dataset-1_walk_normal_001.bvh`, \
+                 with --rig FILE for joint names of its own), or train a model on this rig with \
+                 `mocap clean train`",
+                known.len(),
+                known[..known.len().min(3)].join(", "),
+                names.len(),
+                k + 1,
+                names[k],
+                known.get(k).map_or("", String::as_str),
+            )));
+        }
         Ok(layout)
     }
 

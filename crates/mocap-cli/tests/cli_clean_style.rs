@@ -739,6 +739,38 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
         }
     }
 
+    // The denoiser reads joints in its own rig's places: same count, other
+    // names is refused, and the take played by the model's rig first is
+    // cleaned as the original is.
+    let cleaned_renamed = dir.path().join("cleaned-renamed.bvh");
+    let out = mocap(&["--rig", rig, "clean", renamed, "-o", path(&cleaned_renamed)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("\"Wurzel\" where the model has \"joint_Root\""),
+        "{}",
+        stderr(&out)
+    );
+    let on_bandai = dir.path().join("on-bandai.bvh");
+    let out = mocap(&[
+        "--rig",
+        rig,
+        "convert",
+        renamed,
+        path(&on_bandai),
+        "--retarget-to",
+        &walk,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let cleaned = dir.path().join("cleaned.bvh");
+    for (input, output) in [
+        (path(&on_bandai), &cleaned_renamed),
+        (walk.as_str(), &cleaned),
+    ] {
+        let out = mocap(&["clean", input, "-o", path(output)]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    assert!(rotation_change_deg(&cleaned, &cleaned_renamed) < 1e-3);
+
     // A rig file with a mistake stops the command before it starts.
     let typo = dir.path().join("typo.toml");
     std::fs::write(&typo, "[parts]\npelvis = \"Becken\"\nhead = Kopf\n").unwrap();
