@@ -61,9 +61,10 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
         _ => bail!("`mocap convert` needs at least one input and an output path"),
     };
     let mut motions = io::read_motions(inputs)?.into_iter();
-    let Some((_, mut motion)) = motions.next() else {
+    let Some((first, mut motion)) = motions.next() else {
         bail!("no input motion given");
     };
+    let first = MotionSource::display_name(&first);
     for (source, next) in motions {
         motion
             .append(&next)
@@ -77,7 +78,7 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
         motion = ops::resample_fps(&motion, fps)?;
     }
     if args.mirror {
-        motion = ops::mirror_auto(&motion)?;
+        motion = ops::mirror_auto(&motion).with_context(|| format!("mirroring {first}"))?;
     }
     if let Some(factor) = args.scale {
         motion = ops::scale(&motion, factor);
