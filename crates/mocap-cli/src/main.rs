@@ -21,8 +21,8 @@ struct Cli {
     #[arg(long, short, global = true)]
     quiet: bool,
     /// A rig the built-in tables do not know: a TOML file naming its joints
-    /// (`[parts] pelvis = "Becken"`...; format: `mocap_core::bodymap`). Used
-    /// for every skeleton that has the joints it names; may be repeated.
+    /// (`[parts] pelvis = "Becken"`...; format: docs/rigs.md). Used for
+    /// every skeleton that has the joints it names; may be repeated.
     #[arg(long, global = true, value_name = "FILE")]
     rig: Vec<std::path::PathBuf>,
     #[command(subcommand)]

@@ -443,7 +443,7 @@ impl BodyMap {
             "cannot find the body parts of this skeleton ({} joints: {}): the closest \
              built-in rig, {}, lacks {}; describe the rig in a TOML file \
              ([parts] {} = \"joint name\") and give it with `mocap --rig FILE` \
-             (in code: register_rig_file or BodyMap::from_toml_file)",
+             (docs/rigs.md; in code: register_rig_file or BodyMap::from_toml_file)",
             skeleton.joint_count(),
             joint_list(skeleton),
             rig.name,

@@ -113,8 +113,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             ),
             None => println!(
                 "  rig        body parts not found (search, restyling and retargeting need them: \
-                 describe the rig in a file and give it with --rig FILE, format in \
-                 mocap_core::bodymap)"
+                 describe the rig in a file and give it with --rig FILE: docs/rigs.md)"
             ),
         }
     }
