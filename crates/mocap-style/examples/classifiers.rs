@@ -43,6 +43,7 @@ fn main() {
             "--content-model" => options.content_model = descriptor(value()),
             "--shrinkage" => options.shrinkage = value().parse().expect("shrinkage"),
             "--seed" => options.seed = value().parse().expect("seed"),
+            "--held-out" => options.held_out_take = value().parse().expect("--held-out last|first"),
             "--style-hop" => options.style_windows.hop = value().parse().expect("seconds"),
             "--mirror" => options.style_mirror_training = true,
             "--trees" => options.trees = value().parse().expect("--trees N"),

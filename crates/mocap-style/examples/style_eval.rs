@@ -27,6 +27,7 @@ fn main() {
         let mut value = || args.next().unwrap_or_else(|| panic!("{a} needs a value"));
         match a.as_str() {
             "--model" => options.model = Some(PathBuf::from(value())),
+            "--held-out" => options.held_out_take = value().parse().expect("--held-out last|first"),
             "--sources" => options.source_contents = list(value()),
             "--styles" => options.style_contents = list(value()),
             "--classifier-contents" => options.classifier_filter.contents = list(value()),

@@ -25,6 +25,7 @@ fn main() {
                 options.filter.contents = value().split(',').map(String::from).collect()
             }
             "--no-hold-out" => options.hold_out = false,
+            "--held-out" => options.held_out_take = value().parse().expect("--held-out last|first"),
             "--resume" => options.resume = true,
             _ => options.inputs.push(PathBuf::from(a)),
         }

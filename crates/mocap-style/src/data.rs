@@ -99,9 +99,36 @@ pub fn labelled_paths(paths: &[PathBuf], filter: &ClipFilter) -> Result<Vec<(Pat
     Ok(out)
 }
 
+/// Which take of every (set, content, style) group of two takes or more is
+/// held out for evaluation: the last (the shipped model's split) or the
+/// first (the other fold, to measure a second time on other clips).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum HeldOutTake {
+    #[default]
+    Last,
+    First,
+}
+
+impl std::str::FromStr for HeldOutTake {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "last" => Ok(HeldOutTake::Last),
+            "first" => Ok(HeldOutTake::First),
+            _ => Err(format!("held-out take {s:?}: expected last or first")),
+        }
+    }
+}
+
 /// The names (file stems) of the held-out takes among labelled files: the
 /// last take of every (set, content, style) group of two takes or more.
 pub fn held_out(files: &[(PathBuf, Labels)]) -> HashSet<String> {
+    held_out_takes(files, HeldOutTake::Last)
+}
+
+/// [`held_out`] with the first or the last take of each group.
+pub fn held_out_takes(files: &[(PathBuf, Labels)], which: HeldOutTake) -> HashSet<String> {
     let mut groups: BTreeMap<(String, String, String), Vec<String>> = BTreeMap::new();
     for (path, l) in files {
         let stem = path
@@ -116,7 +143,10 @@ pub fn held_out(files: &[(PathBuf, Labels)]) -> HashSet<String> {
     groups
         .into_values()
         .filter(|v| v.len() >= 2)
-        .filter_map(|v| v.into_iter().max())
+        .filter_map(|v| match which {
+            HeldOutTake::Last => v.into_iter().max(),
+            HeldOutTake::First => v.into_iter().min(),
+        })
         .collect()
 }
 
@@ -207,5 +237,12 @@ mod tests {
         let mut v: Vec<&str> = h.iter().map(String::as_str).collect();
         v.sort();
         assert_eq!(v, ["d_run_old_004", "d_walk_old_002"]);
+        // The other fold: the first take of the same groups.
+        let h = held_out_takes(&files, HeldOutTake::First);
+        let mut v: Vec<&str> = h.iter().map(String::as_str).collect();
+        v.sort();
+        assert_eq!(v, ["d_run_old_001", "d_walk_old_001"]);
+        assert_eq!("first".parse(), Ok(HeldOutTake::First));
+        assert!("middle".parse::<HeldOutTake>().is_err());
     }
 }

@@ -36,7 +36,9 @@ use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::contact::{heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
-use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter};
+use crate::data::{
+    held_out_takes, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake,
+};
 use crate::features::{up_axis, RigLayout};
 use crate::filmstrip::{draw_filmstrip, FilmstripRow};
 use crate::train::StyleModel;
@@ -84,6 +86,10 @@ pub struct EvalOptions {
     /// [`Model::Discriminant`].
     pub shrinkage: f64,
     pub seed: u64,
+    /// Which take of each group is held out; the model must have been
+    /// trained with the same (see [`HeldOutTake`]).
+    #[serde(default)]
+    pub held_out_take: HeldOutTake,
     /// Folder for filmstrip PNGs (none when `None`).
     pub filmstrips: Option<PathBuf>,
     /// Filmstrips per set.
@@ -112,6 +118,7 @@ impl Default for EvalOptions {
             candidates: None,
             shrinkage: 0.5,
             seed: 1,
+            held_out_take: HeldOutTake::Last,
             filmstrips: None,
             filmstrip_count: 3,
             device: DeviceChoice::Cpu,
@@ -386,7 +393,7 @@ pub fn check_classifiers(
     }
     let mut out = Vec::new();
     for (set, files) in sets {
-        let held = held_out(&files);
+        let held = held_out_takes(&files, options.held_out_take);
         let (test, train): (Vec<_>, Vec<_>) = files.iter().cloned().partition(|(p, _)| {
             held.contains(
                 &p.file_stem()
@@ -551,7 +558,7 @@ fn evaluate_set(
     files: &[(PathBuf, crate::data::Labels)],
     options: &EvalOptions,
 ) -> Result<SetReport> {
-    let held = held_out(files);
+    let held = held_out_takes(files, options.held_out_take);
     let is_test = |p: &Path| {
         held.contains(
             &p.file_stem()

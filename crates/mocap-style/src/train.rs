@@ -34,7 +34,9 @@ use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use crate::convert::Latents;
-use crate::data::{held_out, labelled_paths, list_bvh, load_clips, mirrored, ClipFilter};
+use crate::data::{
+    held_out_takes, labelled_paths, list_bvh, load_clips, mirrored, ClipFilter, HeldOutTake,
+};
 use crate::features::{decompose, Normalization, RigLayout};
 use crate::model::{AutoencoderConfig, StyleAutoencoder};
 use crate::{invalid, Result};
@@ -66,6 +68,9 @@ pub struct TrainOptions {
     pub filter: ClipFilter,
     /// Leave out the held-out evaluation takes (default true).
     pub hold_out: bool,
+    /// Which take of each group is held out (see [`HeldOutTake`]).
+    #[serde(default)]
+    pub held_out_take: HeldOutTake,
     /// Add the mirror image of every clip (default true).
     pub mirror: bool,
     /// Frames per training window (report: 240).
@@ -94,6 +99,7 @@ impl Default for TrainOptions {
             out: PathBuf::from("style-ae.safetensors"),
             filter: ClipFilter::default(),
             hold_out: true,
+            held_out_take: HeldOutTake::Last,
             mirror: true,
             window: 240,
             batch_size: 16,
@@ -322,7 +328,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     }
     let files = labelled_paths(&list_bvh(&options.inputs)?, &options.filter)?;
     let held = if options.hold_out {
-        held_out(&files)
+        held_out_takes(&files, options.held_out_take)
     } else {
         Default::default()
     };
