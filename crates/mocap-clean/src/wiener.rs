@@ -251,6 +251,19 @@ fn hermitian_eigen(m: DMatrix<C64>) -> SymmetricEigen<C64, nalgebra::Dyn> {
     SymmetricEigen::new((&m + m.adjoint()) * C64::new(0.5, 0.0))
 }
 
+/// The eigenbasis of spectrum `s` seen through whitening `w`
+/// (`W S W^T = V diag(lambda) V^H`): `V^H W`, which takes channels to
+/// whitened coordinates, `V`, and the eigenvalues (clamped at 0).
+fn whitened_eigenbasis(
+    w: &DMatrix<f64>,
+    s: &DMatrix<C64>,
+) -> (DMatrix<C64>, DMatrix<C64>, Vec<f64>) {
+    let eigen = hermitian_eigen(whiten(w, s));
+    let to_white = complex_times_real(&eigen.eigenvectors.adjoint(), w);
+    let lambda = eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect();
+    (to_white, eigen.eigenvectors, lambda)
+}
+
 /// `W S W^T` for a real `W` and a complex `S`: a spectrum seen through a
 /// whitening.
 fn whiten(w: &DMatrix<f64>, s: &DMatrix<C64>) -> DMatrix<C64> {
@@ -644,17 +657,11 @@ impl WienerFilter {
                 let level_bins = spectra
                     .par_iter()
                     .map(|s| {
-                        let noisy_white = hermitian_eigen(whiten(&whitening.noisy, s));
+                        let (noisy_to_white, _, noisy_lambda) =
+                            whitened_eigenbasis(&whitening.noisy, s);
                         LevelBin {
-                            noisy_to_white: complex_times_real(
-                                &noisy_white.eigenvectors.adjoint(),
-                                &whitening.noisy,
-                            ),
-                            noisy_lambda: noisy_white
-                                .eigenvalues
-                                .iter()
-                                .map(|&l| l.max(0.0))
-                                .collect(),
+                            noisy_to_white,
+                            noisy_lambda,
                         }
                     })
                     .collect();
@@ -684,14 +691,11 @@ impl WienerFilter {
                 .spectra
                 .iter()
                 .map(|s| {
-                    let eigen = hermitian_eigen(whiten(&w.inverse_half, s));
+                    let (to_white, v, lambda) = whitened_eigenbasis(&w.inverse_half, s);
                     Bin {
-                        to_white: complex_times_real(
-                            &eigen.eigenvectors.adjoint(),
-                            &w.inverse_half,
-                        ),
-                        from_white: real_times_complex(&w.half, &eigen.eigenvectors),
-                        lambda: eigen.eigenvalues.iter().map(|&l| l.max(0.0)).collect(),
+                        to_white,
+                        from_white: real_times_complex(&w.half, &v),
+                        lambda,
                     }
                 })
                 .collect()

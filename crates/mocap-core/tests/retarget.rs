@@ -254,9 +254,7 @@ fn a_rig_with_the_same_joints_keeps_every_local_rotation() {
         .unwrap()
         .apply(&take)
         .unwrap();
-    assert_eq!(moved.skeleton(), other.skeleton());
-    let errors = joint_rotation_errors_degrees(&take, &moved).unwrap();
-    assert!(errors.iter().all(|&e| e < 0.01), "{errors:?}");
+    assert_every_local_rotation_kept(&take, &moved, &other);
     // Strides scale with the legs: the pelvis at half its path.
     assert_pelvis_at_half(&take, &moved);
 }
@@ -279,8 +277,14 @@ fn one_rig_under_two_naming_schemes_keeps_every_local_rotation() {
         .unwrap()
         .apply(&take)
         .unwrap();
+    assert_every_local_rotation_kept(&take, &moved, &other);
+}
+
+/// `moved` is `take` played by the rig of `other`, every joint with the
+/// local rotation it has in `take`.
+fn assert_every_local_rotation_kept(take: &Motion, moved: &Motion, other: &Motion) {
     assert_eq!(moved.skeleton(), other.skeleton());
-    let errors = joint_rotation_errors_degrees(&take, &moved).unwrap();
+    let errors = joint_rotation_errors_degrees(take, moved).unwrap();
     assert!(errors.iter().all(|&e| e < 0.01), "{errors:?}");
 }
 
