@@ -272,6 +272,20 @@ impl ConvertOptions {
         if self.fade_in_frames.is_nan() || self.fade_in_frames < 0.0 {
             return Err(invalid("the fade-in must be a non-negative duration"));
         }
+        // A patch too short to stretch by one step would quietly give fixed
+        // patches under the elastic name.
+        if self.method == Method::ElasticPatches && self.patch_lengths().len() < 2 {
+            let shortest = (self.stretch_step as f32 / self.stretch).ceil() as usize;
+            return Err(invalid(format!(
+                "elastic patches stretch a patch by up to {:.0}% in steps of {} frames, so a \
+                 patch of {} frames cannot stretch: use a patch of {} frames or more, or fixed \
+                 patches (--no-elastic)",
+                self.stretch * 100.0,
+                self.stretch_step,
+                self.patch,
+                shortest + shortest % 2,
+            )));
+        }
         Ok(())
     }
 

@@ -55,7 +55,7 @@ fn parse_frame_range(text: &str, len: usize) -> anyhow::Result<std::ops::Range<u
     Ok(start..end)
 }
 
-pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
+pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     let (output, inputs) = match args.paths.split_last() {
         Some((output, inputs)) if !inputs.is_empty() => (output, inputs),
         _ => bail!("`mocap convert` needs at least one input and an output path"),
@@ -90,5 +90,14 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
             .with_context(|| format!("retargeting onto the rig of {}", rig.display()))?;
     }
     io::write_motion(output, &motion)?;
+    if !options.quiet {
+        eprintln!(
+            "wrote {} ({} frames at {:.3} fps, {} joints)",
+            output.display(),
+            motion.frame_count(),
+            motion.fps(),
+            motion.skeleton().joint_count()
+        );
+    }
     Ok(())
 }

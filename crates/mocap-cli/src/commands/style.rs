@@ -36,7 +36,8 @@ struct TrainArgs {
     /// The model file to write (safetensors).
     #[arg(long, short)]
     output: PathBuf,
-    /// Train on these contents only (comma separated; default: walking contents).
+    /// Train on these contents only (comma separated; default: every clip in the folders; the
+    /// shipped model: walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right).
     #[arg(long, value_delimiter = ',')]
     contents: Vec<String>,
     #[arg(long)]
@@ -75,7 +76,7 @@ struct TrainArgs {
 struct ApplyArgs {
     /// The motion to restyle (BVH).
     source: PathBuf,
-    /// One example clip of the style (BVH, same rig as the source).
+    /// One example clip of the style (BVH; a clip of another rig is retargeted onto the source's).
     #[arg(long)]
     style: PathBuf,
     /// The restyled motion (BVH, the source's skeleton).
@@ -86,7 +87,7 @@ struct ApplyArgs {
     model: Option<PathBuf>,
     /// 1: full style, 0: the source; in between, the pose and (with elastic patches) the timing are
     /// interpolated, so 0.5 lasts about halfway between the source and the full style.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     strength: f32,
     /// Fixed patches instead of elastic ones (the style's timing is not carried over).
     #[arg(long)]
