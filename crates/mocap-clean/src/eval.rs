@@ -170,6 +170,10 @@ pub struct EvalReport {
     #[serde(default)]
     pub tuned_despike: Vec<(String, DespikeOptions, f64)>,
     pub spike_survival: Vec<SpikeSurvival>,
+    /// What the figures above do not say on their own: methods left out,
+    /// tuning on the evaluated takes, conditions without spikes.
+    #[serde(default)]
+    pub notes: Vec<String>,
 }
 
 /// The noise conditions evaluated: random noise alone, spikes on top of
@@ -480,6 +484,35 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     } else {
         Vec::new()
     };
+    let mut notes = Vec::new();
+    if options.filters && tune_takes.len() < 2 {
+        notes.push(format!(
+            "the classical filters are left out: tuning them needs at least two validation \
+             takes, and the validation split of these {} takes holds {} (give more takes, or \
+             --all-takes to tune on the evaluated takes themselves)",
+            paths.len(),
+            tune_takes.len()
+        ));
+    } else if !options.test_split_only && (options.filters || options.despike) {
+        notes.push(format!(
+            "the filters{} were tuned on the first {} of the evaluated takes themselves \
+             (--all-takes): their figures are optimistic next to those of a model on takes it \
+             never saw",
+            if options.despike {
+                " and spike finding"
+            } else {
+                ""
+            },
+            tune_takes.len()
+        ));
+    }
+    if takes.len() < 2 {
+        notes.push(
+            "one take: a spike pastes another take's motion, so the spike conditions have no \
+             spikes here (evaluate two takes or more)"
+                .into(),
+        );
+    }
     for condition in 0..CONDITIONS.len() {
         let mut cleaners = Vec::new();
         if options.filters && tune_takes.len() >= 2 {
@@ -606,6 +639,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         tuned_filters,
         tuned_despike,
         spike_survival,
+        notes,
     })
 }
 
@@ -613,8 +647,11 @@ impl EvalReport {
     /// The report as Markdown tables.
     pub fn to_markdown(&self) -> String {
         let mut s = format!("{} takes, {} frames.\n\n", self.takes, self.frames);
+        for note in &self.notes {
+            s += &format!("Note: {note}.\n\n");
+        }
         if !self.tuned_despike.is_empty() {
-            s += "Spike finding tuned on the validation takes (spike condition):\n\n\
+            s += "Spike finding tuned (spike condition):\n\n\
                   | method | threshold | span (frames) | rotations | longest spike (frames) | rotation error there (deg) |\n\
                   | --- | ---: | ---: | --- | ---: | ---: |\n";
             for (label, d, error) in &self.tuned_despike {

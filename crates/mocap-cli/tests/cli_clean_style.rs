@@ -782,3 +782,53 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
         stderr(&out)
     );
 }
+
+#[test]
+fn clean_eval_says_what_its_figures_leave_out() {
+    // One take: no validation takes to tune the filters on, and no other
+    // take to paste spikes from; the report says both instead of quietly
+    // showing fewer rows and spike-free spike conditions.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(mocap_testdata::sample_walk(), dir.path().join("walk.bvh")).unwrap();
+    let out = mocap(&[
+        "clean",
+        "eval",
+        path(dir.path()),
+        "--no-default-model",
+        "--spike-lengths",
+        "none",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let notes: Vec<&str> = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(notes[0].contains("filters are left out"), "{notes:?}");
+    assert!(notes[1].contains("no spikes"), "{notes:?}");
+    // Tuned on the evaluated takes themselves: said too.
+    std::fs::copy(
+        mocap_testdata::sample("dataset-1_walk_proud_001.bvh"),
+        dir.path().join("proud.bvh"),
+    )
+    .unwrap();
+    let out = mocap(&[
+        "clean",
+        "eval",
+        path(dir.path()),
+        "--all-takes",
+        "--no-default-model",
+        "--spike-lengths",
+        "none",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("tuned on the first 2 of the evaluated takes themselves"),
+        "{text}"
+    );
+}

@@ -101,6 +101,7 @@ struct TrainArgs {
     /// The model file to write (safetensors).
     #[arg(long, short)]
     output: PathBuf,
+    /// Training epochs (default 20).
     #[arg(long)]
     epochs: Option<usize>,
     /// Training steps per epoch.
@@ -112,6 +113,8 @@ struct TrainArgs {
     /// Adam learning rate (report: 1e-3).
     #[arg(long)]
     lr: Option<f64>,
+    /// Seed of the weights, the windows drawn and the noise (default 1): the same seed and data
+    /// give the same model.
     #[arg(long)]
     seed: Option<u64>,
     /// `derivative` (rotation + velocity + acceleration terms, alpha = dt^2, beta = dt^4) or `mse`.
@@ -247,7 +250,9 @@ struct EvalArgs {
     /// before the first filter and every model.
     #[arg(long, value_name = "FILE")]
     spike_model: Option<PathBuf>,
-    /// Evaluate every take, not only the test split (for data the models were not trained on).
+    /// Evaluate every take, not only the test split (for data the models were not trained on);
+    /// the filters and spike finding are then tuned on the first --tune-takes of those same takes,
+    /// which flatters them (the report says so).
     #[arg(long)]
     all_takes: bool,
     /// Evaluate at most this many takes.
@@ -267,8 +272,10 @@ struct EvalArgs {
     /// [0, MAX] (default: the report's 10; 0 measures what a method does to clean takes).
     #[arg(long, value_name = "MAX", value_parser = degrees_at_least_zero)]
     max_sigma: Option<f32>,
+    /// Seed of the noise put on the takes (default 1): the same seed gives the same figures.
     #[arg(long)]
     seed: Option<u64>,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
     /// Also write the Markdown tables to this file.
@@ -351,15 +358,21 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
                 );
             }
         };
+        // With --despike-only nothing is cleaned after the bridging.
+        let when = if a.despike_only {
+            "(no cleaning after)"
+        } else {
+            "before cleaning"
+        };
         if find_spikes_asked {
             eprintln!(
-                "spike detector: bridged {} spikes before cleaning",
+                "spike detector: bridged {} spikes {when}",
                 report.detected_spikes.len()
             );
             list(&report.detected_spikes);
         }
         if a.despike {
-            eprintln!("bridged {} spikes before cleaning", report.spikes.len());
+            eprintln!("bridged {} spikes {when}", report.spikes.len());
             list(&report.spikes);
         }
     }

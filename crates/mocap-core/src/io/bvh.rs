@@ -532,10 +532,19 @@ impl<R: BufRead> Parser<R> {
             None => return Err(self.lines.error(1, 1, "empty file: expected HIERARCHY")),
             Some(t) if is_keyword(self.lines.text(t), "HIERARCHY") => {}
             Some(t) => {
-                let found = show(self.lines.text(t));
+                let text = self.lines.text(t);
+                let found = show(text);
+                // An AMC motion or an ASF skeleton given where a BVH file
+                // goes: say how to make one.
+                let hint = if text.starts_with(b":") || text.starts_with(b"#") {
+                    " (an ASF/AMC file? make a BVH of it first: `mocap convert SKELETON.asf \
+                     MOTION.amc take.bvh`)"
+                } else {
+                    ""
+                };
                 return Err(self
                     .lines
-                    .error_at(t, format!("expected HIERARCHY, found {found}")));
+                    .error_at(t, format!("expected HIERARCHY, found {found}{hint}")));
             }
         }
         let mut joints: Vec<Joint> = Vec::new();
