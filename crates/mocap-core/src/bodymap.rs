@@ -424,6 +424,25 @@ impl BodyMap {
         if let Some(rig) = registered.iter().find(|rig| rig.fits(skeleton)) {
             return BodyMap::from_rig_file(&rig.file, &rig.path, skeleton);
         }
+        // Rig files given that do not fit, and the joints each lacks: a
+        // misspelt name in one would otherwise look like no file at all.
+        let unfit: Vec<String> = registered
+            .iter()
+            .map(|rig| {
+                let lacking: Vec<String> = rig
+                    .file
+                    .joint_names()
+                    .filter(|n| find_joint(skeleton, n).is_none())
+                    .map(|n| format!("{n:?}"))
+                    .take(4)
+                    .collect();
+                format!(
+                    "{} names {}, which this skeleton lacks",
+                    rig.path.display(),
+                    lacking.join(", ")
+                )
+            })
+            .collect();
         drop(registered);
         let names = NameIndex::new(skeleton);
         let (rig, map) = best_rig(&names);
@@ -439,11 +458,16 @@ impl BodyMap {
             .iter()
             .map(|&p| format!("{p} (tried {})", rig_candidates(rig, p).join(", ")))
             .collect();
+        let given = if unfit.is_empty() {
+            String::new()
+        } else {
+            format!("; a rig file given does not fit it: {}", unfit.join("; "))
+        };
         Err(Error::Invalid(format!(
             "cannot find the body parts of this skeleton ({} joints: {}): the closest \
              built-in rig, {}, lacks {}; describe the rig in a TOML file \
              ([parts] {} = \"joint name\") and give it with `mocap --rig FILE` \
-             (docs/rigs.md; in code: register_rig_file or BodyMap::from_toml_file)",
+             (docs/rigs.md; in code: register_rig_file or BodyMap::from_toml_file){given}",
             skeleton.joint_count(),
             joint_list(skeleton),
             rig.name,

@@ -45,6 +45,21 @@ fn a_registered_rig_file_reaches_every_detect_for_the_skeletons_it_fits() {
     assert!(err.contains("absent.toml"), "{err}");
     assert!(BodyMap::detect(renamed.skeleton()).is_err());
 
+    // A misspelt joint: the file is registered but fits no skeleton, and
+    // the error says so instead of looking as if no file were given.
+    let misspelt = dir.path().join("misspelt.toml");
+    std::fs::write(
+        &misspelt,
+        RENAMED_BANDAI_RIG.replace("\"Becken\"", "\"Beckn\""),
+    )
+    .unwrap();
+    register_rig_file(&misspelt).unwrap();
+    let err = BodyMap::detect(renamed.skeleton()).unwrap_err().to_string();
+    assert!(
+        err.contains("misspelt.toml names \"Beckn\", which this skeleton lacks"),
+        "{err}"
+    );
+
     let rig = dir.path().join("studio.toml");
     std::fs::write(&rig, RENAMED_BANDAI_RIG).unwrap();
     register_rig_file(&rig).unwrap();

@@ -21,7 +21,7 @@ pub fn skeleton_file_for(amc: &Path) -> Result<PathBuf> {
         .unwrap_or_default();
     let entries = std::fs::read_dir(dir).map_err(|e| SearchError::Io {
         path: dir.to_path_buf(),
-        source: e,
+        error: e,
     })?;
     let mut skeletons: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))

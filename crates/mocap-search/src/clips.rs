@@ -36,12 +36,12 @@ pub fn motion_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
         let entries = std::fs::read_dir(dir).map_err(|e| SearchError::Io {
             path: dir.to_path_buf(),
-            source: e,
+            error: e,
         })?;
         for entry in entries {
             let entry = entry.map_err(|e| SearchError::Io {
                 path: dir.to_path_buf(),
-                source: e,
+                error: e,
             })?;
             let path = entry.path();
             if path.is_dir() {
@@ -61,7 +61,7 @@ pub fn motion_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
         } else {
             return Err(SearchError::Io {
                 path: input.clone(),
-                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or folder"),
+                error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or folder"),
             });
         }
     }

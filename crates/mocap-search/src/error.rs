@@ -9,11 +9,12 @@ pub enum SearchError {
     /// the features need.
     #[error(transparent)]
     Core(#[from] mocap_core::Error),
-    #[error("{path}: {source}")]
+    /// (The I/O error is in the message, not a `source`, so that printing
+    /// the error chain does not repeat it, as in `mocap_core::Error::Io`.)
+    #[error("{path}: {error}")]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A label pattern, label file or clip name that does not give a label.
     #[error("{0}")]

@@ -107,8 +107,9 @@ pub enum Ranking {
     /// Euclidean distance between the forest's class histograms (eq. 8).
     Histogram,
     /// One minus the forest proximity along the trees' paths
-    /// ([`Forest::path_proximity`]); finds clips of classes the forest was
-    /// not trained on.
+    /// ([`Forest::path_proximity`]). For clips of classes the forest was not
+    /// trained on the histogram distance measured better
+    /// (bench/results/search.md, "Unseen classes").
     Proximity,
     /// Euclidean distance between the standardised resampled features.
     Features,
@@ -183,7 +184,12 @@ impl QueryReport {
         if !others.is_empty() {
             s += &format!("  then: {}\n", others.join(", "));
         }
-        s += &format!("nearest clips ({:?} distance):\n", self.ranking);
+        let ranking = match self.ranking {
+            Ranking::Histogram => "histogram distance, eq. 8",
+            Ranking::Proximity => "forest path proximity",
+            Ranking::Features => "feature distance",
+        };
+        s += &format!("nearest clips ({ranking}):\n");
         for m in &self.matches {
             s += &format!(
                 "{:>4}  {:.4}  {:<24} {}\n",
@@ -466,7 +472,7 @@ impl Index {
     pub fn load(path: &Path) -> Result<Index> {
         let bytes = std::fs::read(path).map_err(|e| SearchError::Io {
             path: path.to_path_buf(),
-            source: e,
+            error: e,
         })?;
         let mut index = Index::from_bytes(&bytes, path)?;
         let folder = absolute(&index_folder(path));

@@ -158,7 +158,7 @@ impl LabelFile {
     pub fn read(path: &Path) -> Result<LabelFile, SearchError> {
         let text = std::fs::read_to_string(path).map_err(|e| SearchError::Io {
             path: path.to_path_buf(),
-            source: e,
+            error: e,
         })?;
         LabelFile::parse(&text, path)
     }

@@ -115,14 +115,17 @@ struct IndexArgs {
 struct QueryArgs {
     /// The query clip (BVH, or AMC next to its ASF).
     clip: PathBuf,
+    /// The library to search (from `mocap search index`).
     #[arg(long)]
     index: PathBuf,
     /// Number of library clips to list.
     #[arg(long, default_value_t = 10)]
     top: usize,
-    /// histogram (the report's eq. 8), proximity (finds classes the forest never saw), features.
+    /// histogram (the report's eq. 8; measured best, also for classes the forest never saw),
+    /// proximity (forest path proximity) or features (distance between the clips' features).
     #[arg(long, default_value = "histogram")]
     rank: Ranking,
+    /// Print the result as JSON on standard output.
     #[arg(long)]
     json: bool,
 }
@@ -134,16 +137,19 @@ struct FindArgs {
     /// The long take to search in.
     #[arg(long = "in", value_name = "TAKE")]
     take: PathBuf,
+    /// The library whose forest compares the query and the take's windows.
     #[arg(long)]
     index: PathBuf,
     /// Number of time ranges to list.
     #[arg(long, default_value_t = 10)]
     top: usize,
     /// windows (sliding windows of several lengths) or dtw (subsequence DTW).
-    #[arg(long, default_value = "windows")]
+    #[arg(long, default_value = "windows", value_parser = ["windows", "dtw"])]
     method: String,
+    /// How windows are compared with the query: histogram, proximity or features (as for query).
     #[arg(long, default_value = "histogram")]
     rank: Ranking,
+    /// Print the time ranges as JSON on standard output.
     #[arg(long)]
     json: bool,
 }
@@ -198,10 +204,13 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             let index = build_index(&clips, &rule_name, &a.forest.config(), progress)?;
             index.save(&a.output)?;
             if !options.quiet {
+                let plural = |n: usize, one: &str, many: &str| {
+                    format!("{n} {}", if n == 1 { one } else { many })
+                };
                 eprintln!(
-                    "indexed {} clips of {} classes into {}",
-                    clips.len(),
-                    index.classes.len(),
+                    "indexed {} of {} into {}",
+                    plural(clips.len(), "clip", "clips"),
+                    plural(index.classes.len(), "class", "classes"),
                     a.output.display()
                 );
             }
