@@ -27,7 +27,7 @@ run_eval() { # name, label pattern, folder...
         echo
         echo "Command: \`$cmd\`"
         echo
-        "$TARGET/eval" --labels-from-name "$pattern" --folds 5 "$@"
+        "$TARGET/search_eval" --labels-from-name "$pattern" --folds 5 "$@"
     } >"$TMP/$name.md"
 }
 
@@ -51,7 +51,7 @@ done
     echo
     echo "Command: \`cargo run --release -p mocap-search --example search_eval -- --labels-from-name bandai-content --no-unseen --no-takes D2_WALK_RUN --test D1_WALK_RUN\` (folders of links to the walk_ and run_ files)"
     echo
-    "$TARGET/eval" --labels-from-name bandai-content --no-unseen --no-takes \
+    "$TARGET/search_eval" --labels-from-name bandai-content --no-unseen --no-takes \
         --name "dataset-2 walk/run -> dataset-1 walk/run" "$TMP/d2-walk-run" --test "$TMP/d1-walk-run"
 } >"$TMP/cross.md"
 
@@ -67,7 +67,7 @@ echo "== fold seeds" >&2
     echo "| --- | --- | ---: | ---: | ---: | ---: | --- |"
     for spec in "dataset-1 bandai-content 20" "dataset-1 bandai-style 20" "dataset-2 bandai-content 5" "dataset-2 bandai-style 5"; do
         set -- $spec
-        echo "| $1 | $2 $(EVAL="$TARGET/eval" bash bench/search/seeds.sh "$2" "$DATA/$1" "$3")"
+        echo "| $1 | $2 $(EVAL="$TARGET/search_eval" bash bench/search/seeds.sh "$2" "$DATA/$1" "$3")"
     done
 } >"$TMP/seeds.md"
 

@@ -169,8 +169,9 @@ struct EvalArgs {
     /// Split by performer (from the label rule) instead of folds.
     #[arg(long)]
     by_performer: bool,
-    /// Test on these clips instead of cross-validating.
-    #[arg(long)]
+    /// Test on these clips (files or folders) instead of cross-validating; every path after
+    /// --test is a test path, so give the training inputs first.
+    #[arg(long, num_args = 1..)]
     test: Vec<PathBuf>,
     /// Skip the deterministic tree, random tree and DTW baselines.
     #[arg(long)]
