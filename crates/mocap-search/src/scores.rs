@@ -97,10 +97,13 @@ impl ConfusionMatrix {
             .filter(|s| s.support >= min_support.max(1))
             .collect();
         let n = present.len().max(1) as f64;
+        // Folded from +0.0: an empty float sum is -0.0, printed "-0.000".
+        let mean =
+            |score: fn(&ClassScores) -> f64| present.iter().map(score).fold(0.0, |a, b| a + b) / n;
         ClassScores {
-            precision: present.iter().map(|s| s.precision).sum::<f64>() / n,
-            recall: present.iter().map(|s| s.recall).sum::<f64>() / n,
-            f_measure: present.iter().map(|s| s.f_measure).sum::<f64>() / n,
+            precision: mean(|s| s.precision),
+            recall: mean(|s| s.recall),
+            f_measure: mean(|s| s.f_measure),
             support: present.iter().map(|s| s.support).sum(),
         }
     }
