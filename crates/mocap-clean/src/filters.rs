@@ -249,6 +249,10 @@ impl std::str::FromStr for Filter {
                 )))
             }
         };
+        // What does not depend on the frame rate is checked now, so that a
+        // command line with an even median window is refused as such; the
+        // cutoffs are checked against the take's frame rate when it is read.
+        filter.validate(f32::INFINITY)?;
         Ok(filter)
     }
 }
