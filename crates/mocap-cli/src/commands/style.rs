@@ -7,6 +7,7 @@ use anyhow::{bail, Context};
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, parse_blend, ApplyOptions};
 use mocap_style::convert::{Method, RootPath};
+use mocap_style::data::HeldOutTake;
 use mocap_style::eval::{evaluate, EvalOptions};
 use mocap_style::train::{train, TrainOptions};
 
@@ -59,6 +60,10 @@ struct TrainArgs {
     /// Train on every clip (no held-out evaluation takes).
     #[arg(long)]
     no_hold_out: bool,
+    /// Which take of each (set, content, style) group of two or more `style eval` holds out:
+    /// last (the shipped model's fold) or first (the other fold).
+    #[arg(long, default_value = "last", value_name = "last|first")]
+    held_out: HeldOutTake,
     /// cpu, or cuda[:N] in a build with the `cuda` feature.
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
@@ -131,6 +136,10 @@ struct EvalArgs {
     /// The autoencoder (default: the shipped model).
     #[arg(long)]
     model: Option<PathBuf>,
+    /// Which take of each group is held out and tested: last, or first (the other fold; the
+    /// model must have been trained with `style train --held-out first`).
+    #[arg(long, default_value = "last", value_name = "last|first")]
+    held_out: HeldOutTake,
     /// Contents of the source clips (comma separated; default all).
     #[arg(long, value_delimiter = ',')]
     sources: Vec<String>,
@@ -192,6 +201,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 inputs: a.inputs,
                 out: a.output,
                 hold_out: !a.no_hold_out,
+                held_out_take: a.held_out,
                 mirror: !a.no_mirror,
                 window: a.window.unwrap_or(defaults.window),
                 batch_size: a.batch.unwrap_or(defaults.batch_size),
@@ -268,6 +278,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             let mut eval_options = EvalOptions {
                 inputs: a.inputs,
                 model: a.model,
+                held_out_take: a.held_out,
                 source_contents: a.sources,
                 style_contents: a.styles,
                 trees: a.trees,
