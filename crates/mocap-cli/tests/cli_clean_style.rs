@@ -832,3 +832,42 @@ fn clean_eval_says_what_its_figures_leave_out() {
         "{text}"
     );
 }
+
+#[test]
+fn style_apply_says_when_the_source_is_unlike_the_walks_the_model_knows() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("out.bvh");
+    let proud = sample("dataset-1_walk_proud_001.bvh");
+    let apply = |source: &str| {
+        mocap(&[
+            "style",
+            "apply",
+            source,
+            "--style",
+            &proud,
+            "-o",
+            path(&out_path),
+        ])
+    };
+    // A walk: reproduced closely, no note.
+    let walk = mocap_testdata::sample_walk().display().to_string();
+    let out = apply(&walk);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("reproduces this source poorly"),
+        "{}",
+        stderr(&out)
+    );
+    let Some(bow) = mocap_testdata::shared("bandai/dataset-1/dataset-1_bow_normal_001.bvh") else {
+        return;
+    };
+    // A bow: the model cannot reproduce it, and the user is told so (the
+    // output walks in place instead of bowing).
+    let out = apply(&bow.display().to_string());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("reproduces this source poorly"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -31,7 +31,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::io::write_motion;
 use mocap_core::ops::resample_fps;
 use mocap_core::retarget::Retargeting;
-use mocap_core::rotation::Vec3;
+use mocap_core::rotation::{angle_between, Quat, Vec3};
 use mocap_core::Motion;
 use mocap_core::Skeleton;
 use mocap_nn::device::DeviceChoice;
@@ -188,7 +188,41 @@ pub struct Restyled {
     /// How far the feet moved the root from the source's path (file units;
     /// zero with [`RootPath::Source`]).
     pub root_shift: RootShift,
+    /// How well the autoencoder reproduces the source with no style at all
+    /// (see [`reconstruction_error_deg`]).
+    pub source_reconstruction_deg: f32,
 }
+
+/// Mean angle (degrees) between the local rotations of the model's joints
+/// and those the autoencoder gives back after encoding and decoding them,
+/// with no conversion. The autoencoder only knows motion like the walks it
+/// was trained on: a source it cannot reproduce (a bow, a kick) cannot be
+/// restyled either, since every output pose is decoded from its latent
+/// space; this measures how far a source is from that space.
+pub fn reconstruction_error_deg(
+    model: &StyleModel,
+    rotations: &[Quat],
+    latents: &Latents,
+) -> Result<f32> {
+    let decoded = model.decode(latents)?;
+    let back = model.description.normalization.rotations(&decoded);
+    let n = rotations.len().min(back.len()).max(1);
+    let sum: f64 = rotations
+        .iter()
+        .zip(&back)
+        .map(|(&a, &b)| angle_between(a, b) as f64)
+        .sum();
+    Ok((sum / n as f64).to_degrees() as f32)
+}
+
+/// A source whose [`reconstruction_error_deg`] exceeds this is far from the
+/// motion the shipped model was trained on, and its content is likely lost.
+/// Measured with the shipped model on every Bandai clip (`familiarity`
+/// example; bench/results/style.md, "Sources the model cannot
+/// reproduce"): above 7 degrees lie 2.7% of the clips of the walking
+/// contents it was trained on and 93.7% of the others (gestures, runs,
+/// kicks...).
+pub const UNFAMILIAR_SOURCE_DEG: f32 = 7.0;
 
 /// Restyles `source` (any frame rate; output at the same rate) to the
 /// weighted styles.
@@ -225,6 +259,9 @@ pub fn restyle(
     let t = Instant::now();
     let latents = model.encode(&features)?;
     timings.encode += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let source_reconstruction_deg = reconstruction_error_deg(model, &rotations, &latents)?;
+    timings.decode += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let inputs: Vec<StyleInput> = scaled
@@ -262,6 +299,7 @@ pub fn restyle(
         conversion,
         timings,
         root_shift,
+        source_reconstruction_deg,
     })
 }
 
@@ -312,6 +350,11 @@ pub struct ApplyReport {
     /// distance it travels in the source (about 1 when the root follows the
     /// source's path; the strides set it with [`RootPath::Feet`]).
     pub distance_ratio: f64,
+    /// How well the autoencoder reproduces the source with no style
+    /// ([`reconstruction_error_deg`], degrees); above
+    /// [`UNFAMILIAR_SOURCE_DEG`] the source is unlike the model's training
+    /// motion and its content is likely lost.
+    pub source_reconstruction_deg: f32,
     /// Mean source frames per patch over the patch length (main series).
     pub mean_patch_stretch: f64,
     /// Mean cosine similarity of the matched patches.
@@ -510,6 +553,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         time_scale: output.duration() / source.duration(),
         // Measured on the model's rig (before any retargeting back).
         distance_ratio: (travelled(&restyled.motion, rig) / travelled(&source_on_rig, rig)) as f64,
+        source_reconstruction_deg: restyled.source_reconstruction_deg,
         mean_patch_stretch,
         mean_similarity: if sims.is_empty() {
             f64::NAN
