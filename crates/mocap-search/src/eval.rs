@@ -161,7 +161,28 @@ pub struct UnseenReport {
     pub per_class: Vec<(String, Vec<f64>)>,
     /// Mean average precision of a random ranking, for reference.
     pub chance_map: f64,
+    /// Whether a query's class is in the library at all, told by the
+    /// forest's top class probability: per threshold, the share of clips of
+    /// trained classes (cross-validation test clips) and of clips of the
+    /// held-out class that fall below it.
+    #[serde(default)]
+    pub novelty: Vec<NoveltyRow>,
 }
+
+/// One threshold of [`UnseenReport::novelty`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NoveltyRow {
+    /// Top class probability below which a query is called "not in the
+    /// library".
+    pub threshold: f32,
+    /// Share of clips of trained classes called so (false alarms).
+    pub known_below: f64,
+    /// Share of clips of classes the forest never saw called so.
+    pub unseen_below: f64,
+}
+
+/// The top class probabilities [`UnseenReport::novelty`] is measured at.
+const NOVELTY_THRESHOLDS: [f32; 6] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8];
 
 /// The long-take experiment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -516,6 +537,8 @@ fn run(
     let data = prepare(clips, labels, config);
     let c = classes.len();
     let mut forest_tally = Tally::new("forest", c);
+    // The top class probability of every test clip (of a trained class).
+    let mut known_top = Vec::new();
     let mut det_tally = Tally::new("deterministic tree", c);
     let mut random_tally = Tally::new("random tree", c);
     let mut dtw_tally = Tally::new("DTW 1-NN", c);
@@ -553,6 +576,7 @@ fn run(
             forest_tally
                 .confusion
                 .add(data.labels[k] as usize, argmax(h));
+            known_top.push(h.iter().copied().fold(0.0, f32::max));
         }
 
         // Ranking: test clips query the training clips.
@@ -677,7 +701,7 @@ fn run(
         ranking.push(rank_dtw.scores("DTW distance"));
     }
     let unseen = if config.unseen_classes {
-        Some(unseen_classes(&data, classes, config)?)
+        Some(unseen_classes(&data, classes, config, &known_top)?)
     } else {
         None
     };
@@ -713,7 +737,9 @@ fn unseen_classes(
     data: &Prepared,
     classes: &[String],
     config: &EvalConfig,
+    known_top: &[f32],
 ) -> Result<UnseenReport> {
+    let mut unseen_top = Vec::new();
     let names = [
         "forest histogram, eq. 8",
         "forest path proximity",
@@ -753,6 +779,7 @@ fn unseen_classes(
             RankTally::default(),
         ];
         for &q in &members {
+            unseen_top.push(histograms[q].iter().copied().fold(0.0, f32::max));
             // The library is every other clip; relevant = the held-out class.
             let others: Vec<usize> = (0..n).filter(|&k| k != q).collect();
             let library_labels: Vec<u32> = others.iter().map(|&k| data.labels[k]).collect();
@@ -797,6 +824,18 @@ fn unseen_classes(
             .collect(),
         per_class,
         chance_map: chance / c,
+        novelty: NOVELTY_THRESHOLDS
+            .iter()
+            .map(|&t| {
+                let below =
+                    |v: &[f32]| v.iter().filter(|&&p| p < t).count() as f64 / v.len().max(1) as f64;
+                NoveltyRow {
+                    threshold: t,
+                    known_below: below(known_top),
+                    unseen_below: below(&unseen_top),
+                }
+            })
+            .collect(),
     })
 }
 
@@ -1081,6 +1120,17 @@ impl EvalReport {
                     s += &format!(" {m:.3} |");
                 }
                 s += "\n";
+            }
+            if !u.novelty.is_empty() {
+                s += "\nIs the query's class in the library at all? Called \"not in the library\" when the forest's top class probability is below a threshold: the share of test clips of trained classes (cross-validation) and of clips of the held-out class (above) so called:\n\n| top probability below | trained classes (false alarms) | held-out class (found) |\n| ---: | ---: | ---: |\n";
+                for row in &u.novelty {
+                    s += &format!(
+                        "| {:.1} | {:.1}% | {:.1}% |\n",
+                        row.threshold,
+                        100.0 * row.known_below,
+                        100.0 * row.unseen_below
+                    );
+                }
             }
         }
         if let Some(t) = &self.takes {
