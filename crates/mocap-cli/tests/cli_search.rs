@@ -146,3 +146,34 @@ fn eval_draws_a_confusion_matrix_per_method() {
         .count();
     assert_eq!(drawn, 2 * methods.len(), "a PNG and an SVG per method");
 }
+
+#[test]
+fn a_query_on_an_index_moved_without_its_clips_says_so() {
+    // The shipped index keeps its clips' paths relative to `models/`; a
+    // copy elsewhere answers with paths that lead nowhere, and says so.
+    let dir = tempfile::tempdir().unwrap();
+    let moved = dir.path().join("x/y/library.idx");
+    std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    std::fs::copy(repo.join("models/search-bandai-content.idx"), &moved).unwrap();
+    let sample = repo.join("samples/dataset-1_walk_normal_001.bvh");
+    let out = mocap(&[
+        "search",
+        "query",
+        sample.to_str().unwrap(),
+        "--index",
+        moved.to_str().unwrap(),
+        "--top",
+        "3",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("3 of the 3 clips listed are not where"),
+        "{stderr}"
+    );
+}
