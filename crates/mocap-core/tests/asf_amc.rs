@@ -879,3 +879,29 @@ fn error_missing_file_is_an_io_error() {
         other => panic!("expected an I/O error, got {other:?}"),
     }
 }
+
+#[test]
+fn an_amc_given_alone_takes_the_asf_beside_it() {
+    use mocap_core::io::MotionSource;
+    let Some(dir) = mocap_testdata::shared("hdm05-sample") else {
+        return;
+    };
+    let amc = dir.join("HDM_bd_depositFloorR_001_120.amc");
+    let sources = MotionSource::group(std::slice::from_ref(&amc)).unwrap();
+    assert_eq!(
+        sources,
+        [MotionSource::AsfAmc {
+            asf: dir.join("HDM_bd.asf"),
+            amc: amc.clone(),
+        }]
+    );
+    // Alone in a folder without an ASF: refused, saying what to give.
+    let empty = tempfile::tempdir().unwrap();
+    let lone = empty.path().join("HDM_bd_take.amc");
+    std::fs::copy(&amc, &lone).unwrap();
+    let err = MotionSource::group(&[lone]).unwrap_err().to_string();
+    assert!(
+        err.contains("no ASF skeleton file") && err.contains("HDM_bd_take.amc"),
+        "{err}"
+    );
+}

@@ -75,7 +75,7 @@
 //! rate at the end of its name, as in `..._120.amc`.)
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Location, ParseError, Result};
 use crate::motion::Motion;
@@ -383,6 +383,54 @@ const ROTATION_CHANNELS: [Channel; 3] =
 /// `R = R_n ... R_2 R_1` (angles in radians).
 fn fixed_axes_rotation(sequence: impl Iterator<Item = (Axis, f32)>) -> Quat {
     sequence.fold(Quat::IDENTITY, |q, (axis, angle)| axis.rotation(angle) * q)
+}
+
+/// The ASF skeleton of an AMC motion given alone: in the same folder, the
+/// `.asf` file whose name (without extension) is the longest prefix of the
+/// AMC's name (`HDM_bd.asf` for `HDM_bd_walk4StepsLstart_001_120.amc`,
+/// `01.asf` for `01_02.amc`), or the only `.asf` file there.
+pub fn skeleton_file_for(amc: &Path) -> Result<PathBuf> {
+    let dir = match amc.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let stem = amc
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut skeletons: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("asf"))
+        })
+        .collect();
+    skeletons.sort();
+    let prefix_len = |p: &PathBuf| {
+        let s = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        stem.starts_with(&s).then_some(s.len())
+    };
+    if let Some((_, best)) = skeletons
+        .iter()
+        .filter_map(|p| prefix_len(p).map(|n| (n, p)))
+        .max_by_key(|(n, _)| *n)
+    {
+        return Ok(best.clone());
+    }
+    if skeletons.len() == 1 {
+        return Ok(skeletons.remove(0));
+    }
+    Err(Error::Invalid(format!(
+        "{}: no ASF skeleton file for this AMC motion in {} (give it before the AMC, or put one \
+         whose name starts the AMC's name beside it, e.g. `HDM_bd.asf` for `HDM_bd_*.amc`)",
+        amc.display(),
+        dir.display()
+    )))
 }
 
 /// Reads an ASF skeleton file.

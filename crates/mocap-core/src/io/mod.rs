@@ -29,7 +29,9 @@ pub enum MotionSource {
 
 impl MotionSource {
     /// Groups command-line paths into motions: each `.bvh` is one motion; an
-    /// `.asf` pairs with every `.amc` that follows it (`X.asf A.amc B.amc`).
+    /// `.asf` pairs with every `.amc` that follows it (`X.asf A.amc B.amc`);
+    /// an `.amc` with no `.asf` before it takes the one beside it
+    /// ([`asf_amc::skeleton_file_for`]).
     pub fn group(paths: &[PathBuf]) -> Result<Vec<MotionSource>> {
         let mut sources = Vec::new();
         let mut current_asf: Option<&PathBuf> = None;
@@ -37,18 +39,15 @@ impl MotionSource {
             match extension(path).as_str() {
                 "bvh" => sources.push(MotionSource::Bvh(path.clone())),
                 "asf" => current_asf = Some(path),
-                "amc" => match current_asf {
-                    Some(asf) => sources.push(MotionSource::AsfAmc {
-                        asf: asf.clone(),
-                        amc: path.clone(),
-                    }),
-                    None => {
-                        return Err(Error::Invalid(format!(
-                        "{}: an AMC motion needs its ASF skeleton before it on the command line",
-                        path.display()
-                    )))
-                    }
-                },
+                // An AMC takes the ASF given before it, else the one beside
+                // it (`asf_amc::skeleton_file_for`).
+                "amc" => sources.push(MotionSource::AsfAmc {
+                    asf: match current_asf {
+                        Some(asf) => asf.clone(),
+                        None => asf_amc::skeleton_file_for(path)?,
+                    },
+                    amc: path.clone(),
+                }),
                 _ => {
                     return Err(Error::Invalid(format!(
                         "{}: unknown motion file type (expected .bvh, or .asf followed by .amc)",
