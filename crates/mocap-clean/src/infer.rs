@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
-use mocap_core::io::bvh::{read_bvh, write_bvh};
+use mocap_core::io::bvh::write_bvh;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
     header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
@@ -576,7 +576,7 @@ impl BridgedSpike {
 
 /// Reads a take, cleans it and writes it (atomically).
 pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
-    let original = read_bvh(&options.input)?;
+    let original = mocap_core::io::read_motion(&options.input)?;
     let in_file = |e: CleanError| match e {
         CleanError::Invalid(m) => CleanError::Invalid(format!("{}: {m}", options.input.display())),
         other => other,
@@ -668,6 +668,7 @@ mod tests {
     use crate::features::Representation;
     use crate::model::DenoiserConfig;
     use crate::test_support::synthetic_motion;
+    use mocap_core::io::bvh::read_bvh;
     use mocap_nn::checkpoint::{weights_to_bytes, CheckpointHeader};
 
     fn model_bytes(representation: Representation, joints: usize) -> Vec<u8> {

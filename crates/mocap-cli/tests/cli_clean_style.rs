@@ -871,3 +871,37 @@ fn style_apply_says_when_the_source_is_unlike_the_walks_the_model_knows() {
         stderr(&out)
     );
 }
+
+#[test]
+fn clean_reads_an_amc_motion_with_the_asf_beside_it() {
+    let Some(amc) = mocap_testdata::shared("hdm05-sample/HDM_bd_depositFloorR_001_120.amc") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("clean.bvh");
+    let out = mocap(&[
+        "clean",
+        path(&amc),
+        "-o",
+        path(&out_path),
+        "--filter",
+        "butterworth-gcv:2",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let cleaned = read_bvh(&out_path).unwrap();
+    let original = mocap_core::io::read_motion(&amc).unwrap();
+    assert_eq!(cleaned.frame_count(), original.frame_count());
+    // The same joints and channels (a BVH file has no joint limits).
+    let names = |m: &mocap_core::Motion| -> Vec<String> {
+        m.skeleton()
+            .joints()
+            .iter()
+            .map(|j| j.name.clone())
+            .collect()
+    };
+    assert_eq!(names(&cleaned), names(&original));
+    assert_eq!(
+        cleaned.skeleton().channel_count(),
+        original.skeleton().channel_count()
+    );
+}
