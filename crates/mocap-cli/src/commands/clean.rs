@@ -436,6 +436,17 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.model.display(),
             report.plot.display()
         );
+        // The report's network on its own is not the shipped recipe, and
+        // measured behind a per-take Butterworth: say so where it is made.
+        if o.base_wiener.is_none() && o.base_filter.is_none() && !o.spike_detector {
+            eprintln!(
+                "note: this is the report's network alone; on the Bandai test takes it measured \
+                 behind `--filter butterworth-gcv:2` (bench/results/clean.md). The shipped model \
+                 corrects a Wiener filter: `mocap clean train DIR --wiener -o wiener.safetensors`, \
+                 then `--base-wiener wiener.safetensors --base-context 128 --base-input` \
+                 (docs/clean-guide.md, \"Training your own Wiener filter or model\")"
+            );
+        }
     }
     Ok(())
 }
