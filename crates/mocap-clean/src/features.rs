@@ -185,6 +185,15 @@ impl FeatureLayout {
         })
     }
 
+    /// The names of the joints with features, in feature order: what a
+    /// model or filter fitted to one rig checks another take's rig against.
+    pub fn joint_names(&self, skeleton: &Skeleton) -> Vec<String> {
+        self.joints
+            .iter()
+            .map(|&j| skeleton.joint(j).name.clone())
+            .collect()
+    }
+
     /// The same layout with rotations in `frame`. Euler angles only come in
     /// the local frame: their channel order is the joint's own.
     pub fn in_frame(mut self, frame: RotationFrame) -> Result<FeatureLayout> {

@@ -172,15 +172,9 @@ impl CleanModel {
         // As many joints is not the same rig: the network reads each
         // joint's features in its place, so they must be the same joints
         // in the same order.
-        let names: Vec<&str> = layout
-            .joints
-            .iter()
-            .map(|&j| motion.skeleton().joint(j).name.as_str())
-            .collect();
+        let names = layout.joint_names(motion.skeleton());
         let known = &self.description.joints;
-        if let Some(k) =
-            (0..names.len()).find(|&k| known.get(k).map(String::as_str) != Some(names[k]))
-        {
+        if let Some(k) = (0..names.len()).find(|&k| known.get(k) != Some(&names[k])) {
             return Err(CleanError::Invalid(format!(
                 "the model was trained on a rig of {} joints with rotations ({}, ...), this take's \
                  {} joints with rotations are others: joint {} is {:?} where the model has {:?}. \

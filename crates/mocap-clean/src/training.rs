@@ -668,11 +668,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let fps = first.motion.fps() as f32;
     let layout = FeatureLayout::new(first.motion.skeleton(), options.representation)?
         .in_frame(options.frame)?;
-    let joints: Vec<String> = layout
-        .joints
-        .iter()
-        .map(|&j| first.motion.skeleton().joint(j).name.clone())
-        .collect();
+    let joints = layout.joint_names(first.motion.skeleton());
     let mut network = options.network;
     network.channels = layout.channels();
     // Any base: a classical filter or a Wiener filter.

@@ -244,7 +244,6 @@ fn noise_ridge(noise: &DMatrix<f64>) -> f64 {
     1e-6 * noise.trace() / noise.nrows().max(1) as f64 + 1e-12
 }
 
-/// Periodic Hann window of `len` frames at `t`.
 /// The eigendecomposition of a matrix Hermitian up to rounding
 /// (symmetrised before the solver).
 fn hermitian_eigen(m: DMatrix<C64>) -> SymmetricEigen<C64, nalgebra::Dyn> {
@@ -284,6 +283,7 @@ fn complex_times_real(a: &DMatrix<C64>, b: &DMatrix<f64>) -> DMatrix<C64> {
     re.zip_map(&im, C64::new)
 }
 
+/// Periodic Hann window of `len` frames at `t`.
 fn hann(t: usize, len: usize) -> f64 {
     0.5 - 0.5 * (2.0 * PI * t as f64 / len as f64).cos()
 }
@@ -480,13 +480,13 @@ impl WienerFilter {
             .first()
             .ok_or_else(|| CleanError::Invalid("no takes to fit a Wiener filter to".into()))?;
         let layout = FeatureLayout::new(first.skeleton(), Representation::Rot6d)?;
-        let joints = joint_names(first, &layout);
+        let joints = layout.joint_names(first.skeleton());
         let same_rig: Vec<&Motion> = takes
             .iter()
             .copied()
             .filter(|m| {
                 FeatureLayout::new(m.skeleton(), Representation::Rot6d)
-                    .is_ok_and(|l| joint_names(m, &l) == joints)
+                    .is_ok_and(|l| l.joint_names(m.skeleton()) == joints)
             })
             .collect();
         let c = layout.channels();
@@ -705,7 +705,7 @@ impl WienerFilter {
     /// The features of `motion`'s rig, or an error naming both rigs.
     fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
         let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
-        let names = joint_names(motion, &layout);
+        let names = layout.joint_names(motion.skeleton());
         if names != self.description.joints {
             let d = &self.description.joints;
             return Err(CleanError::Invalid(format!(
@@ -1409,15 +1409,6 @@ pub fn fit_mixture(
     }
     parts.push(("all".to_string(), single.clone()));
     WienerFilter::mixture(parts)
-}
-
-/// The names of the joints of `layout` (those with rotation channels).
-fn joint_names(motion: &Motion, layout: &FeatureLayout) -> Vec<String> {
-    layout
-        .joints
-        .iter()
-        .map(|&j| motion.skeleton().joint(j).name.clone())
-        .collect()
 }
 
 #[cfg(test)]

@@ -97,14 +97,11 @@ pub fn read_motions(paths: &[PathBuf]) -> Result<Vec<(MotionSource, Motion)>> {
 /// Reads one motion file: a BVH file, or an AMC motion with the ASF
 /// skeleton beside it ([`asf_amc::skeleton_file_for`]).
 pub fn read_motion(path: &Path) -> Result<Motion> {
-    let mut motions = read_motions(&[path.to_path_buf()])?;
-    match motions.len() {
-        1 => Ok(motions.remove(0).1),
-        _ => Err(Error::Invalid(format!(
-            "{}: expected one motion file (.bvh, or .amc with its .asf beside it)",
-            path.display()
-        ))),
-    }
+    // One path groups into one motion or an error (a lone `.asf` is one).
+    let source = MotionSource::group(&[path.to_path_buf()])?
+        .pop()
+        .expect("a path that groups without error is one motion");
+    source.read()
 }
 
 /// Writes a motion to `path`, choosing the format from the extension.
