@@ -1,5 +1,5 @@
 //! How well the style autoencoder reproduces each clip with no style
-//! ([`mocap_style::apply::reconstruction_error_deg`]), by set and content:
+//! ([`mocap_style::apply::source_reconstruction_deg`]), by set and content:
 //! the measurement behind [`mocap_style::apply::UNFAMILIAR_SOURCE_DEG`].
 //!
 //! ```text
@@ -15,9 +15,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{load_model, reconstruction_error_deg};
+use mocap_style::apply::{load_model, source_reconstruction_deg};
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-use mocap_style::features::decompose;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut model_path = None;
@@ -49,12 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut groups: BTreeMap<(String, String), Vec<f32>> = BTreeMap::new();
     for (path, labels) in &files {
         let motion = mocap_core::io::bvh::read_bvh(path)?;
-        let Ok(prepared) = model.prepare(&motion, &path.display().to_string()) else {
-            continue;
-        };
-        let (rotations, _) = decompose(&prepared, &model.description.rig);
-        let latents = model.encode(&model.features(&rotations))?;
-        let error = reconstruction_error_deg(&model, &rotations, &latents)?;
+        let error = source_reconstruction_deg(&model, &motion)?;
         groups
             .entry((labels.set.clone(), labels.content.clone()))
             .or_default()

@@ -31,7 +31,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::io::write_motion;
 use mocap_core::ops::resample_fps;
 use mocap_core::retarget::Retargeting;
-use mocap_core::rotation::{angle_between, Quat, Vec3};
+use mocap_core::rotation::{angle_between, Vec3};
 use mocap_core::Motion;
 use mocap_core::Skeleton;
 use mocap_nn::device::DeviceChoice;
@@ -188,23 +188,21 @@ pub struct Restyled {
     /// How far the feet moved the root from the source's path (file units;
     /// zero with [`RootPath::Source`]).
     pub root_shift: RootShift,
-    /// How well the autoencoder reproduces the source with no style at all
-    /// (see [`reconstruction_error_deg`]).
-    pub source_reconstruction_deg: f32,
 }
 
 /// Mean angle (degrees) between the local rotations of the model's joints
-/// and those the autoencoder gives back after encoding and decoding them,
-/// with no conversion. The autoencoder only knows motion like the walks it
-/// was trained on: a source it cannot reproduce (a bow, a kick) cannot be
-/// restyled either, since every output pose is decoded from its latent
-/// space; this measures how far a source is from that space.
-pub fn reconstruction_error_deg(
-    model: &StyleModel,
-    rotations: &[Quat],
-    latents: &Latents,
-) -> Result<f32> {
-    let decoded = model.decode(latents)?;
+/// in `source` and those the autoencoder gives back after encoding and
+/// decoding them, with no conversion. The autoencoder only knows motion like
+/// the walks it was trained on: a source it cannot reproduce (a bow, a kick)
+/// cannot be restyled either, since every output pose is decoded from its
+/// latent space; this measures how far a source is from that space. Run by
+/// [`apply`] once per source, not by [`restyle`], which the evaluation runs
+/// for every pair.
+pub fn source_reconstruction_deg(model: &StyleModel, source: &Motion) -> Result<f32> {
+    let source = model.prepare(source, "source")?;
+    let (rotations, _) = decompose(&source, &model.description.rig);
+    let latents = model.encode(&model.features(&rotations))?;
+    let decoded = model.decode(&latents)?;
     let back = model.description.normalization.rotations(&decoded);
     let n = rotations.len().min(back.len()).max(1);
     let sum: f64 = rotations
@@ -215,7 +213,7 @@ pub fn reconstruction_error_deg(
     Ok((sum / n as f64).to_degrees() as f32)
 }
 
-/// A source whose [`reconstruction_error_deg`] exceeds this is far from the
+/// A source whose [`source_reconstruction_deg`] exceeds this is far from the
 /// motion the shipped model was trained on, and its content is likely lost.
 /// Measured with the shipped model on every Bandai clip (`familiarity`
 /// example; bench/results/style.md, "Sources the model cannot
@@ -223,6 +221,9 @@ pub fn reconstruction_error_deg(
 /// contents it was trained on and 93.7% of the others (gestures, runs,
 /// kicks...).
 pub const UNFAMILIAR_SOURCE_DEG: f32 = 7.0;
+
+/// [`ApplyReport::model`] when the shipped model restyled.
+pub const BUILT_IN_MODEL: &str = "built-in default";
 
 /// Restyles `source` (any frame rate; output at the same rate) to the
 /// weighted styles.
@@ -259,9 +260,6 @@ pub fn restyle(
     let t = Instant::now();
     let latents = model.encode(&features)?;
     timings.encode += t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let source_reconstruction_deg = reconstruction_error_deg(model, &rotations, &latents)?;
-    timings.decode += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let inputs: Vec<StyleInput> = scaled
@@ -299,7 +297,6 @@ pub fn restyle(
         conversion,
         timings,
         root_shift,
-        source_reconstruction_deg,
     })
 }
 
@@ -351,7 +348,7 @@ pub struct ApplyReport {
     /// source's path; the strides set it with [`RootPath::Feet`]).
     pub distance_ratio: f64,
     /// How well the autoencoder reproduces the source with no style
-    /// ([`reconstruction_error_deg`], degrees); above
+    /// ([`source_reconstruction_deg`], degrees); above
     /// [`UNFAMILIAR_SOURCE_DEG`] the source is unlike the model's training
     /// motion and its content is likely lost.
     pub source_reconstruction_deg: f32,
@@ -368,6 +365,24 @@ pub struct ApplyReport {
     /// done with them.
     #[serde(default)]
     pub retargeted: Vec<String>,
+}
+
+impl ApplyReport {
+    /// A note when the shipped model reproduces the source poorly (above
+    /// [`UNFAMILIAR_SOURCE_DEG`]; measured for that model only, so none for
+    /// another one).
+    pub fn unfamiliar_source_note(&self) -> Option<String> {
+        (self.model == BUILT_IN_MODEL && self.source_reconstruction_deg > UNFAMILIAR_SOURCE_DEG)
+            .then(|| {
+                format!(
+                    "{}: the model reproduces this source poorly ({:.1} degrees off with no \
+                     style; walks like those it was trained on: about 3-5): it is unlike the \
+                     walking motion the model knows, and its content is likely lost in the output",
+                    self.source.display(),
+                    self.source_reconstruction_deg
+                )
+            })
+    }
 }
 
 /// Loads the model of `options` (or the default one).
@@ -539,7 +554,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         model: options
             .model
             .as_ref()
-            .map_or("built-in default".to_string(), |p| p.display().to_string()),
+            .map_or(BUILT_IN_MODEL.to_string(), |p| p.display().to_string()),
         method: options.method,
         strength: options.strength,
         fade_in_seconds: options.fade_in_seconds,
@@ -553,7 +568,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         time_scale: output.duration() / source.duration(),
         // Measured on the model's rig (before any retargeting back).
         distance_ratio: (travelled(&restyled.motion, rig) / travelled(&source_on_rig, rig)) as f64,
-        source_reconstruction_deg: restyled.source_reconstruction_deg,
+        source_reconstruction_deg: source_reconstruction_deg(&model, &source_on_rig)?,
         mean_patch_stretch,
         mean_similarity: if sims.is_empty() {
             f64::NAN

@@ -341,7 +341,9 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         model: options
             .model
             .as_ref()
-            .map_or("built-in default".to_string(), |p| p.display().to_string()),
+            .map_or(crate::apply::BUILT_IN_MODEL.to_string(), |p| {
+                p.display().to_string()
+            }),
         options: options.clone(),
         sets: reports,
         seconds: started.elapsed().as_secs_f64(),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{apply, parse_blend, ApplyOptions, UNFAMILIAR_SOURCE_DEG};
+use mocap_style::apply::{apply, parse_blend, ApplyOptions};
 use mocap_style::convert::{Method, RootPath};
 use mocap_style::data::HeldOutTake;
 use mocap_style::eval::{evaluate, EvalOptions};
@@ -264,18 +264,8 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 for note in &report.retargeted {
                     eprintln!("note: {note}");
                 }
-                // Measured for the shipped model only.
-                if apply_options.model.is_none()
-                    && report.source_reconstruction_deg > UNFAMILIAR_SOURCE_DEG
-                {
-                    eprintln!(
-                        "note: {}: the model reproduces this source poorly ({:.1} degrees off \
-                         with no style; walks like those it was trained on: about 3-5): it is \
-                         unlike the walking motion the model knows, and its content is likely lost \
-                         in the output",
-                        report.source.display(),
-                        report.source_reconstruction_deg
-                    );
+                if let Some(note) = report.unfamiliar_source_note() {
+                    eprintln!("note: {note}");
                 }
                 eprintln!(
                     "wrote {} ({} frames from {}; time scale {:.2}, distance ratio {:.2})",
