@@ -122,13 +122,9 @@ impl std::str::FromStr for HeldOutTake {
 }
 
 /// The names (file stems) of the held-out takes among labelled files: the
-/// last take of every (set, content, style) group of two takes or more.
-pub fn held_out(files: &[(PathBuf, Labels)]) -> HashSet<String> {
-    held_out_takes(files, HeldOutTake::Last)
-}
-
-/// [`held_out`] with the first or the last take of each group.
-pub fn held_out_takes(files: &[(PathBuf, Labels)], which: HeldOutTake) -> HashSet<String> {
+/// last (or first, see [`HeldOutTake`]) take of every (set, content, style)
+/// group of two takes or more.
+pub fn held_out(files: &[(PathBuf, Labels)], which: HeldOutTake) -> HashSet<String> {
     let mut groups: BTreeMap<(String, String, String), Vec<String>> = BTreeMap::new();
     for (path, l) in files {
         let stem = path
@@ -233,12 +229,12 @@ mod tests {
         .iter()
         .map(|n| (PathBuf::from(n), labels_from_name(Path::new(n)).unwrap()))
         .collect();
-        let h = held_out(&files);
+        let h = held_out(&files, HeldOutTake::Last);
         let mut v: Vec<&str> = h.iter().map(String::as_str).collect();
         v.sort();
         assert_eq!(v, ["d_run_old_004", "d_walk_old_002"]);
         // The other fold: the first take of the same groups.
-        let h = held_out_takes(&files, HeldOutTake::First);
+        let h = held_out(&files, HeldOutTake::First);
         let mut v: Vec<&str> = h.iter().map(String::as_str).collect();
         v.sort();
         assert_eq!(v, ["d_run_old_001", "d_walk_old_001"]);

@@ -36,9 +36,7 @@ use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::contact::{heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
-use crate::data::{
-    held_out_takes, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake,
-};
+use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake};
 use crate::features::{up_axis, RigLayout};
 use crate::filmstrip::{draw_filmstrip, FilmstripRow};
 use crate::train::StyleModel;
@@ -395,7 +393,7 @@ pub fn check_classifiers(
     }
     let mut out = Vec::new();
     for (set, files) in sets {
-        let held = held_out_takes(&files, options.held_out_take);
+        let held = held_out(&files, options.held_out_take);
         let (test, train): (Vec<_>, Vec<_>) = files.iter().cloned().partition(|(p, _)| {
             held.contains(
                 &p.file_stem()
@@ -560,7 +558,7 @@ fn evaluate_set(
     files: &[(PathBuf, crate::data::Labels)],
     options: &EvalOptions,
 ) -> Result<SetReport> {
-    let held = held_out_takes(files, options.held_out_take);
+    let held = held_out(files, options.held_out_take);
     let is_test = |p: &Path| {
         held.contains(
             &p.file_stem()

@@ -35,7 +35,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::convert::Latents;
 use crate::data::{
-    held_out_takes, labelled_paths, list_bvh, load_clips, mirrored, ClipFilter, HeldOutTake,
+    held_out, labelled_paths, list_bvh, load_clips, mirrored, ClipFilter, HeldOutTake,
 };
 use crate::features::{decompose, Normalization, RigLayout};
 use crate::model::{AutoencoderConfig, StyleAutoencoder};
@@ -328,7 +328,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     }
     let files = labelled_paths(&list_bvh(&options.inputs)?, &options.filter)?;
     let held = if options.hold_out {
-        held_out_takes(&files, options.held_out_take)
+        held_out(&files, options.held_out_take)
     } else {
         Default::default()
     };
