@@ -740,11 +740,7 @@ fn unseen_classes(
     known_top: &[f32],
 ) -> Result<UnseenReport> {
     let mut unseen_top = Vec::new();
-    let names = [
-        "forest histogram, eq. 8",
-        "forest path proximity",
-        "feature distance",
-    ];
+    let names = [Ranking::Histogram, Ranking::Proximity, Ranking::Features].map(Ranking::describe);
     let (mean, scale) = value_statistics(&data.resampled);
     let features: Vec<FeatureSequence> = data
         .resampled

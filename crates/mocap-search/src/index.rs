@@ -115,6 +115,17 @@ pub enum Ranking {
     Features,
 }
 
+impl Ranking {
+    /// What the distance is, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Ranking::Histogram => "forest histogram, eq. 8",
+            Ranking::Proximity => "forest path proximity",
+            Ranking::Features => "feature distance",
+        }
+    }
+}
+
 impl std::str::FromStr for Ranking {
     type Err = SearchError;
     fn from_str(s: &str) -> Result<Ranking> {
@@ -168,6 +179,16 @@ pub struct QueryReport {
 }
 
 impl QueryReport {
+    /// How many of the listed clips are not at their paths: the index keeps
+    /// them relative to its own folder, so one moved without its clips
+    /// answers with paths that lead nowhere.
+    pub fn missing_clips(&self) -> usize {
+        self.matches
+            .iter()
+            .filter(|m| !Path::new(&m.path).exists())
+            .count()
+    }
+
     /// Plain text for a terminal.
     pub fn to_text(&self) -> String {
         let mut s = format!(
@@ -184,12 +205,7 @@ impl QueryReport {
         if !others.is_empty() {
             s += &format!("  then: {}\n", others.join(", "));
         }
-        let ranking = match self.ranking {
-            Ranking::Histogram => "histogram distance, eq. 8",
-            Ranking::Proximity => "forest path proximity",
-            Ranking::Features => "feature distance",
-        };
-        s += &format!("nearest clips ({ranking}):\n");
+        s += &format!("nearest clips ({}):\n", self.ranking.describe());
         for m in &self.matches {
             s += &format!(
                 "{:>4}  {:.4}  {:<24} {}\n",

@@ -1,6 +1,6 @@
 //! `mocap search`: motion retrieval by example (mocap-search).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use mocap_search::eval::evaluate_train_test;
@@ -221,14 +221,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             let (features, _fps) = load_features(&a.clip)?;
             let report = index.query(&a.clip.display().to_string(), &features, a.top, a.rank);
             print_result(&report, a.json, || report.to_text())?;
-            // The index keeps its clips' paths relative to its own folder:
-            // an index moved without its clips answers with paths that lead
-            // nowhere.
-            let missing = report
-                .matches
-                .iter()
-                .filter(|m| !Path::new(&m.path).exists())
-                .count();
+            let missing = report.missing_clips();
             if missing > 0 && !options.quiet {
                 eprintln!(
                     "note: {missing} of the {} clips listed are not where {} says (it stores them \
