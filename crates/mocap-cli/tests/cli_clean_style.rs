@@ -905,3 +905,45 @@ fn clean_reads_an_amc_motion_with_the_asf_beside_it() {
         original.skeleton().channel_count()
     );
 }
+
+#[test]
+fn style_apply_reads_an_amc_source_as_its_converted_bvh() {
+    let Some(dir) = mocap_testdata::shared("hdm05-sample") else {
+        return;
+    };
+    let (asf, amc) = (
+        dir.join("HDM_bd.asf"),
+        dir.join("HDM_bd_depositFloorR_001_120.amc"),
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let bvh = tmp.path().join("hdm.bvh");
+    let out = mocap(&["convert", path(&asf), path(&amc), path(&bvh)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let proud = sample("dataset-1_walk_proud_001.bvh");
+    let restyle = |source: &Path, name: &str| {
+        let out_path = tmp.path().join(name);
+        let out = mocap(&[
+            "style",
+            "apply",
+            path(source),
+            "--style",
+            &proud,
+            "-o",
+            path(&out_path),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        read_bvh(&out_path).unwrap()
+    };
+    let (from_amc, from_bvh) = (restyle(&amc, "a.bvh"), restyle(&bvh, "b.bvh"));
+    assert_eq!(from_amc.frame_count(), from_bvh.frame_count());
+    let (pa, pb) = (
+        mocap_core::forward_kinematics(&from_amc),
+        mocap_core::forward_kinematics(&from_bvh),
+    );
+    for f in 0..from_amc.frame_count() {
+        for j in 0..from_amc.skeleton().joint_count() {
+            let d = pa.position(f, j).distance(pb.position(f, j));
+            assert!(d < 0.01, "frame {f}, joint {j}: {d} apart");
+        }
+    }
+}

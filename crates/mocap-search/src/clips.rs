@@ -81,9 +81,9 @@ fn is_motion_file(path: &Path) -> bool {
 }
 
 /// Reads a motion file: BVH, or AMC with the skeleton from the ASF file
-/// beside it (see [`crate::asf::skeleton_file_for`]).
+/// beside it ([`mocap_core::io::read_motion`]).
 pub fn load_motion(path: &Path) -> Result<Motion> {
-    Ok(crate::asf::motion_source(path)?.read()?)
+    Ok(mocap_core::io::read_motion(path)?)
 }
 
 /// Reads a motion file and computes its per-frame features; errors name the

@@ -44,7 +44,6 @@
 //! # Ok::<(), mocap_search::SearchError>(())
 //! ```
 
-pub mod asf;
 pub mod clips;
 pub mod dtw;
 pub mod error;

@@ -27,8 +27,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mocap_core::bodymap::BodyMap;
-use mocap_core::io::bvh::read_bvh;
-use mocap_core::io::write_motion;
+use mocap_core::io::{read_motion, write_motion};
 use mocap_core::ops::resample_fps;
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, Vec3};
@@ -410,10 +409,10 @@ fn retargeting(from: &Motion, to: &Motion) -> mocap_core::Result<Retargeting> {
 pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
     let t = Instant::now();
     let model = load_model(options.model.as_deref(), options.device)?;
-    let source = read_bvh(&options.source)?;
-    let style = read_bvh(&options.style)?;
+    let source = read_motion(&options.source)?;
+    let style = read_motion(&options.style)?;
     let blend = match &options.blend {
-        Some((path, w)) => Some((read_bvh(path)?, *w, path)),
+        Some((path, w)) => Some((read_motion(path)?, *w, path)),
         None => None,
     };
     // The rig the restyle runs on: the source's when it is the model's,

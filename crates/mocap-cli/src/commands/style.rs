@@ -79,9 +79,10 @@ struct TrainArgs {
 
 #[derive(clap::Args)]
 struct ApplyArgs {
-    /// The motion to restyle (BVH).
+    /// The motion to restyle (BVH, or AMC with its ASF beside it).
     source: PathBuf,
-    /// One example clip of the style (BVH; a clip of another rig is retargeted onto the source's).
+    /// One example clip of the style (BVH, or AMC with its ASF beside it; a clip of another rig is
+    /// retargeted onto the source's).
     #[arg(long)]
     style: PathBuf,
     /// The restyled motion (BVH, the source's skeleton).
