@@ -291,9 +291,7 @@ fn bandai_lateral_axis_is_x_and_frames_follow_the_rig() {
 }
 
 fn bundled_walk() -> Motion {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../samples/dataset-1_walk_normal_001.bvh");
-    read_bvh(&path).unwrap()
+    read_bvh(&mocap_testdata::sample_walk()).unwrap()
 }
 
 /// The bundled Bandai walk with the performer turned by `degrees` about
