@@ -6,7 +6,8 @@
 //! cargo run -p mocap-style --example classifiers -- [--cv | --cv-style | --cv-content] \
 //!     [--classifier-contents walk,walk-back] [--style-descriptor gait] \
 //!     [--content-descriptor intervals-gait] [--style-window 2] [--content-window 2] \
-//!     [--style-model forest|nearest-mean|discriminant] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] DIR...
+//!     [--style-model forest|nearest-mean|discriminant|conv-net] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
+//!     [--net-epochs 30] [--net-width 64] [--net-kernel 7] [--net-dropout 0.3] [--net-lr 0.001] [--net-velocities] DIR...
 //! ```
 
 use std::path::PathBuf;
@@ -47,6 +48,12 @@ fn main() {
             "--style-hop" => options.style_windows.hop = value().parse().expect("seconds"),
             "--mirror" => options.style_mirror_training = true,
             "--trees" => options.trees = value().parse().expect("--trees N"),
+            "--net-epochs" => options.net.epochs = value().parse().expect("--net-epochs N"),
+            "--net-width" => options.net.width = value().parse().expect("--net-width N"),
+            "--net-kernel" => options.net.kernel = value().parse().expect("--net-kernel N"),
+            "--net-dropout" => options.net.dropout = value().parse().expect("--net-dropout P"),
+            "--net-velocities" => options.net.velocities = true,
+            "--net-lr" => options.net.learning_rate = value().parse().expect("--net-lr L"),
             _ => options.inputs.push(PathBuf::from(a)),
         }
     }

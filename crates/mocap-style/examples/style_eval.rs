@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release -p mocap-style --example style_eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
-//!     [--classifier-contents walk,walk-back] [--patch 32] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
+//!     [--classifier-contents walk,walk-back] [--style-judge forest|conv-net] [--seed S] [--patch 32] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...
 //! ```
 
@@ -44,6 +44,8 @@ fn main() {
                     .expect("intervals or statistics")
             }
             "--trees" => options.trees = value().parse().expect("--trees N"),
+            "--style-judge" => options.set_style_judge(value().parse().expect("--style-judge")),
+            "--seed" => options.seed = value().parse().expect("--seed N"),
             "--methods" => {
                 options.methods = list(value())
                     .iter()

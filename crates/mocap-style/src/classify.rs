@@ -20,6 +20,7 @@ use mocap_search::{Forest, ForestConfig};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use crate::classify_net::{FittedNet, NetConfig};
 use crate::data::{mirrored, Clip};
 use crate::{invalid, Result};
 
@@ -339,6 +340,10 @@ pub enum Model {
     /// together (the deviation and rate of change of one joint) stop being
     /// counted twice.
     Discriminant,
+    /// A small 1-D convolutional network on the window's per-frame values
+    /// (not the descriptor; see [`crate::classify_net`]); a clip's label is
+    /// the class with the largest summed probability over its windows.
+    ConvNet,
 }
 
 /// How a classifier is built.
@@ -358,6 +363,9 @@ pub struct ClassifierConfig {
     /// Shrinkage `s` of [`Model::Discriminant`]'s correlation towards the
     /// identity, in `(0, 1]`.
     pub shrinkage: f64,
+    /// Sizes and training of [`Model::ConvNet`].
+    #[serde(default)]
+    pub net: NetConfig,
     pub seed: u64,
 }
 
@@ -387,6 +395,7 @@ enum Fitted {
         /// values.
         precision: DMatrix<f64>,
     },
+    ConvNet(Box<FittedNet>),
 }
 
 /// Class means of rows, `classes x dim`.
@@ -513,6 +522,7 @@ impl Fitted {
                     *v -= z.dot(&(precision * &z)) as f32;
                 }
             }
+            Fitted::ConvNet(_) => unreachable!("the network votes on windows, not rows"),
         }
     }
 }
@@ -523,6 +533,7 @@ impl ClipClassifier {
         let mut classes: Vec<String> = clips.iter().map(|c| c.1.clone()).collect();
         classes.sort();
         classes.dedup();
+        let mut windows = Vec::new();
         let mut rows = Vec::new();
         let mut labels = Vec::new();
         for (clip, label) in clips {
@@ -533,10 +544,22 @@ impl ClipClassifier {
             }
             for m in &motions {
                 for w in feature_windows(m, config.windows)? {
-                    rows.extend(descriptor_row(config.descriptor, &w, m.fps()));
+                    if config.model == Model::ConvNet {
+                        windows.push(w);
+                    } else {
+                        rows.extend(descriptor_row(config.descriptor, &w, m.fps()));
+                    }
                     labels.push(class);
                 }
             }
+        }
+        if config.model == Model::ConvNet {
+            let net = FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
+            return Ok(ClipClassifier {
+                config,
+                fitted: Fitted::ConvNet(Box::new(net)),
+                classes,
+            });
         }
         let dim = rows.len() / labels.len().max(1);
         let samples = Samples::new(&rows, dim, &labels, classes.len()).map_err(invalid)?;
@@ -556,6 +579,7 @@ impl ClipClassifier {
             Model::Discriminant => {
                 fit_discriminant(&rows, dim, &labels, classes.len(), config.shrinkage)?
             }
+            Model::ConvNet => unreachable!("trained above"),
         };
         Ok(ClipClassifier {
             config,
@@ -569,8 +593,12 @@ impl ClipClassifier {
     pub fn predict(&self, motion: &Motion) -> Result<String> {
         let mut votes = vec![0.0f32; self.classes.len()];
         for w in feature_windows(motion, self.config.windows)? {
-            let row = descriptor_row(self.config.descriptor, &w, motion.fps());
-            self.fitted.add_votes(&row, &mut votes);
+            if let Fitted::ConvNet(net) = &self.fitted {
+                net.add_votes(&w, &mut votes);
+            } else {
+                let row = descriptor_row(self.config.descriptor, &w, motion.fps());
+                self.fitted.add_votes(&row, &mut votes);
+            }
         }
         Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
     }

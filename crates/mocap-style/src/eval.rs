@@ -34,6 +34,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
+use crate::classify_net::NetConfig;
 use crate::contact::{heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake};
@@ -83,6 +84,10 @@ pub struct EvalOptions {
     /// Shrinkage of both classifiers' covariance when their model is
     /// [`Model::Discriminant`].
     pub shrinkage: f64,
+    /// Sizes and training of the classifiers when their model is
+    /// [`Model::ConvNet`].
+    #[serde(default)]
+    pub net: NetConfig,
     pub seed: u64,
     /// Which take of each group is held out; the model must have been
     /// trained with the same (see [`HeldOutTake`]).
@@ -93,6 +98,49 @@ pub struct EvalOptions {
     /// Filmstrips per set.
     pub filmstrip_count: usize,
     pub device: DeviceChoice,
+}
+
+/// Which classifier judges the style of outputs (see
+/// [`EvalOptions::set_style_judge`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StyleJudge {
+    /// The forest on the gait descriptor (the default, chosen by
+    /// cross-validation on real clips).
+    #[default]
+    Forest,
+    /// The small conv net on per-frame values and their changes, trained on
+    /// the clips and their mirror images (a second opinion).
+    ConvNet,
+}
+
+impl std::str::FromStr for StyleJudge {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "forest" => Ok(StyleJudge::Forest),
+            "conv-net" => Ok(StyleJudge::ConvNet),
+            _ => Err(format!("style judge {s:?}: expected forest or conv-net")),
+        }
+    }
+}
+
+impl EvalOptions {
+    /// Judges style with `judge` in the setting measured for it on real
+    /// clips (bench/results/style.md, "A small conv-net judge").
+    pub fn set_style_judge(&mut self, judge: StyleJudge) {
+        match judge {
+            StyleJudge::Forest => {
+                self.style_model = Model::Forest;
+                self.style_mirror_training = false;
+            }
+            StyleJudge::ConvNet => {
+                self.style_model = Model::ConvNet;
+                self.net.velocities = true;
+                self.style_mirror_training = true;
+            }
+        }
+    }
 }
 
 impl Default for EvalOptions {
@@ -115,6 +163,7 @@ impl Default for EvalOptions {
             style_mirror_training: false,
             candidates: None,
             shrinkage: 0.5,
+            net: NetConfig::default(),
             seed: 1,
             held_out_take: HeldOutTake::Last,
             filmstrips: None,
@@ -507,6 +556,7 @@ fn style_config(options: &EvalOptions) -> ClassifierConfig {
         candidates: options.candidates,
         mirror_training: options.style_mirror_training,
         shrinkage: options.shrinkage,
+        net: options.net,
         seed: options.seed,
     }
 }
@@ -520,6 +570,7 @@ fn content_config(options: &EvalOptions) -> ClassifierConfig {
         candidates: options.candidates,
         mirror_training: false,
         shrinkage: options.shrinkage,
+        net: options.net,
         seed: options.seed + 1,
     }
 }

@@ -28,7 +28,8 @@
 //!    (opt-in).
 //! 4. [`apply`]: the whole thing on files (`mocap style apply`); [`eval`]
 //!    measures it on labelled clips (`mocap style eval`) with independent
-//!    classifiers ([`classify`]); [`filmstrip`]
+//!    classifiers ([`classify`]; [`classify_net`], a small conv net, is a
+//!    second style judge); [`filmstrip`]
 //!    draws source, style and output side by side.
 //!
 //! The command line is a thin layer over [`train::TrainOptions`],
@@ -37,6 +38,7 @@
 
 pub mod apply;
 pub mod classify;
+pub mod classify_net;
 pub mod contact;
 pub mod convert;
 pub mod data;

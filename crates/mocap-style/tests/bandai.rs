@@ -248,3 +248,57 @@ fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
         );
     }
 }
+
+/// The second style judge, the small conv net on per-frame pose values,
+/// learns dataset-2 walking styles from four takes each and recognises other
+/// takes of them (the forest recognises every held-out dataset-2 walk).
+#[test]
+fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
+    use mocap_style::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
+    use mocap_style::classify_net::NetConfig;
+    use mocap_style::data::{labelled_paths, load_clips, ClipFilter};
+
+    let styles = ["active", "elderly", "exhausted"];
+    let load = |takes: &[&str]| -> Option<Vec<mocap_style::data::Clip>> {
+        let mut paths = Vec::new();
+        for style in styles {
+            for take in takes {
+                paths.push(bandai(
+                    "dataset-2",
+                    &format!("dataset-2_walk_{style}_{take}.bvh"),
+                )?);
+            }
+        }
+        let files = labelled_paths(&paths, &ClipFilter::default()).unwrap();
+        Some(load_clips(&files).unwrap())
+    };
+    let (Some(train), Some(test)) = (load(&["001", "004", "007", "010"]), load(&["013", "016"]))
+    else {
+        return;
+    };
+    let config = ClassifierConfig {
+        model: Model::ConvNet,
+        descriptor: Descriptor::Gait,
+        windows: Windows::default(),
+        trees: 0,
+        candidates: None,
+        mirror_training: true,
+        shrinkage: 1.0,
+        net: NetConfig {
+            velocities: true,
+            ..NetConfig::default()
+        },
+        seed: 1,
+    };
+    let labelled: Vec<_> = train.iter().map(|c| (c, c.labels.style.clone())).collect();
+    let judge = ClipClassifier::train(&labelled, config).unwrap();
+    assert_eq!(judge.classes(), styles);
+    let mut wrong = Vec::new();
+    for clip in &test {
+        let predicted = judge.predict(&clip.motion).unwrap();
+        if predicted != clip.labels.style {
+            wrong.push((clip.name.clone(), predicted));
+        }
+    }
+    assert!(wrong.len() <= 1, "{wrong:?}");
+}

@@ -8,7 +8,7 @@ use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, parse_blend, ApplyOptions};
 use mocap_style::convert::{Method, RootPath};
 use mocap_style::data::HeldOutTake;
-use mocap_style::eval::{evaluate, EvalOptions};
+use mocap_style::eval::{evaluate, EvalOptions, StyleJudge};
 use mocap_style::train::{train, TrainOptions};
 
 use super::{write_output, GlobalOptions};
@@ -168,6 +168,13 @@ struct EvalArgs {
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
     trees: usize,
+    /// The classifier that judges the outputs' style: the forest on gait descriptors, or a
+    /// small conv net on the per-frame pose values (a second opinion; slower to train).
+    #[arg(long, default_value = "forest", value_name = "forest|conv-net")]
+    style_judge: StyleJudge,
+    /// Seed of the classifiers.
+    #[arg(long, default_value_t = 1)]
+    judge_seed: u64,
     /// Write side-by-side filmstrips (source, style, output) here.
     #[arg(long)]
     filmstrips: Option<PathBuf>,
@@ -305,6 +312,8 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 a.root
             };
             eval_options.convert.foot_contacts = a.foot_contacts;
+            eval_options.set_style_judge(a.style_judge);
+            eval_options.seed = a.judge_seed;
             let report = evaluate(&eval_options)?;
             let markdown = report.to_markdown();
             if let Some(path) = &a.markdown {

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Two style judges side by side (bench/results/style.md, "A second judge: a
+# small conv net"): the forest on gait descriptors (the evaluation's judge) and
+# a small conv net on per-frame pose values, judge seeds 1-3, on both folds:
+# first on real clips (cross-validation leaving one walking content out, and
+# the held-out walks), then judging the outputs of every method.
+#
+#   bash bench/style/judges.sh     # about 45 min on the 2-core machine
+#
+# Needs the other fold's model, which `bash bench/style/run.sh --other-fold`
+# trains (${MODEL_DIR:-/tmp}/style-fold-first.safetensors). The per-run JSON
+# reports (about 1 MB each) stay in ${RUNS_DIR:-/tmp/style-judges}; the tables
+# go to bench/style/out/judges.md.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+DATA=${MOCAP_SHARED_DATA:-../shared/data}/bandai
+export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target-style}
+cargo build -q --profile test -p mocap-style --examples
+BIN=$CARGO_TARGET_DIR/debug/examples
+WALKS=walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right
+MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
+if [[ ! -f "$MODEL" ]]; then
+  echo "needs the other fold's model $MODEL: run bash bench/style/run.sh --other-fold first" >&2
+  exit 1
+fi
+RUNS=${RUNS_DIR:-/tmp/style-judges}
+mkdir -p "$RUNS" bench/style/out
+for judge in forest conv-net; do
+  if [[ $judge == conv-net ]]; then
+    C_ARGS=(--style-model conv-net --net-velocities --mirror)
+  else
+    C_ARGS=(--style-model forest)
+  fi
+  for seed in 1 2 3; do
+    for fold in last first; do
+      FOLD_ARGS=(--held-out "$fold")
+      [[ $fold == first ]] && FOLD_ARGS+=(--model "$MODEL")
+      "$BIN/classifiers" --held-out "$fold" --seed "$seed" --cv-style \
+        --classifier-contents "$WALKS" "${C_ARGS[@]}" "$DATA/dataset-1" \
+        > "$RUNS/classifiers-$judge-$fold-seed$seed.json"
+      "$BIN/style_eval" "${FOLD_ARGS[@]}" --style-judge "$judge" --seed "$seed" \
+        --sources walk,walk-turn-left,walk-turn-right --styles walk \
+        --classifier-contents "$WALKS" --json "$RUNS/eval-$judge-$fold-seed$seed.json" \
+        "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+    done
+  done
+done
+python3 bench/style/judges_table.py "$RUNS" > bench/style/out/judges.md

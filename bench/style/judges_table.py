@@ -1,0 +1,66 @@
+"""Tables of bench/style/run.sh --judges: the two style judges on real clips
+and on outputs, three judge seeds, both folds.
+
+Usage: python3 bench/style/judges_table.py RUNS_DIR > bench/style/out/judges.md
+RUNS_DIR holds classifiers-{forest,conv-net}-{last,first}-seedN.json and
+eval-{forest,conv-net}-{last,first}-seedN.json.
+"""
+import json
+import pathlib
+import sys
+
+root = pathlib.Path(sys.argv[1])
+JUDGES = ["forest", "conv-net"]
+FOLDS = ["last", "first"]
+SEEDS = [1, 2, 3]
+METHODS = ["elastic-patches", "fixed-patches", "whitening-colouring", "adain"]
+
+
+def load(kind, judge, fold, seed):
+    return json.loads((root / f"{kind}-{judge}-{fold}-seed{seed}.json").read_text())
+
+
+print("## The style judges on real dataset-1 clips\n")
+print("Cross-validated: leaving one walking content out at a time (60 training clips);")
+print("held out: the 15 held-out walks, which are the evaluation's style clips.\n")
+print("| judge | fold | cross-validated, seeds 1 / 2 / 3 | mean | held out, seeds 1 / 2 / 3 | mean |")
+print("| --- | --- | --- | --- | --- | --- |")
+for judge in JUDGES:
+    for fold in FOLDS:
+        checks = [
+            next(c for c in load("classifiers", judge, fold, s) if c["set"] == "dataset-1")
+            for s in SEEDS
+        ]
+        cv = [100 * c["cross_validated_style"] for c in checks]
+        held = [100 * c["held_out_style"] for c in checks]
+        print(
+            f"| {judge} | {fold} | {' / '.join(f'{v:.1f}' for v in cv)} | {sum(cv) / 3:.1f} "
+            f"| {' / '.join(f'{v:.1f}' for v in held)} | {sum(held) / 3:.1f} |"
+        )
+
+print("\n## Outputs judged by each, both folds pooled\n")
+print("Style (and content) accuracy of the outputs over both folds' pairs, per judge seed;")
+print("the content judge is the same forest in both rows of a seed.\n")
+print("| set | method | judge | seed 1 | seed 2 | seed 3 | mean style | mean content |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+for data_set in ["dataset-1", "dataset-2"]:
+    for method in METHODS:
+        for judge in JUDGES:
+            cells, style_sum, content_sum, pairs_sum = [], 0.0, 0.0, 0
+            for seed in SEEDS:
+                style = content = pairs = 0
+                for fold in FOLDS:
+                    report = load("eval", judge, fold, seed)
+                    s = next(x for x in report["sets"] if x["set"] == data_set)
+                    m = next(x for x in s["methods"] if x["method"] == method)
+                    style += m["style_accuracy"] * m["pairs"]
+                    content += m["content_accuracy"] * m["pairs"]
+                    pairs += m["pairs"]
+                cells.append(f"{100 * style / pairs:.1f}%")
+                style_sum += style
+                content_sum += content
+                pairs_sum += pairs
+            print(
+                f"| {data_set} | {method} | {judge} | {' | '.join(cells)} "
+                f"| {100 * style_sum / pairs_sum:.1f}% | {100 * content_sum / pairs_sum:.1f}% |"
+            )
