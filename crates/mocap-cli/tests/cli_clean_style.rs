@@ -947,3 +947,54 @@ fn style_apply_reads_an_amc_source_as_its_converted_bvh() {
         }
     }
 }
+
+#[test]
+fn style_eval_names_its_judges_and_can_judge_style_with_the_conv_net() {
+    let Some(data) = mocap_testdata::shared_data() else {
+        return;
+    };
+    // Two dataset-2 walking styles, three takes each: the last take of each
+    // is held out and restyled with the other's.
+    let dir = tempfile::tempdir().unwrap();
+    for style in ["active", "elderly"] {
+        for take in ["001", "004", "007"] {
+            let name = format!("dataset-2_walk_{style}_{take}.bvh");
+            std::fs::copy(
+                data.join("bandai/dataset-2").join(&name),
+                dir.path().join(&name),
+            )
+            .unwrap();
+        }
+    }
+    let eval = |judge: &str| {
+        mocap(&[
+            "style",
+            "eval",
+            path(dir.path()),
+            "--methods",
+            "elastic-patches",
+            "--style-judge",
+            judge,
+        ])
+    };
+    let out = eval("conv-net");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("style: conv net") && text.contains("content: forest"),
+        "{text}"
+    );
+    // Both real held-out walks are judged right, and so is the style clip
+    // row (each real style clip is one of them).
+    assert!(
+        text.contains("| style clip itself | 2 | 100.0% |"),
+        "{text}"
+    );
+    let out = eval("tree");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("expected forest or conv-net"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -376,7 +376,16 @@ pub struct ClipClassifier {
     classes: Vec<String>,
 }
 
+/// What a classifier learnt.
 enum Fitted {
+    /// A model of descriptor rows.
+    Rows(RowModel),
+    /// The conv net, which reads the windows themselves.
+    ConvNet(Box<FittedNet>),
+}
+
+/// A model fitted to one descriptor row per window.
+enum RowModel {
     Forest(Forest),
     NearestMean {
         /// Class means, `classes x dim`.
@@ -395,7 +404,6 @@ enum Fitted {
         /// values.
         precision: DMatrix<f64>,
     },
-    ConvNet(Box<FittedNet>),
 }
 
 /// Class means of rows, `classes x dim`.
@@ -422,7 +430,7 @@ fn fit_discriminant(
     labels: &[u32],
     classes: usize,
     shrinkage: f64,
-) -> Result<Fitted> {
+) -> Result<RowModel> {
     if !(shrinkage > 0.0 && shrinkage <= 1.0) {
         return Err(invalid(format!(
             "classifier: shrinkage must be in (0, 1], got {shrinkage}"
@@ -461,7 +469,7 @@ fn fit_discriminant(
         .cholesky()
         .ok_or_else(|| invalid("classifier: the shrunk correlation is not positive definite"))?
         .inverse();
-    Ok(Fitted::Discriminant {
+    Ok(RowModel::Discriminant {
         means,
         scales,
         precision,
@@ -469,7 +477,7 @@ fn fit_discriminant(
 }
 
 /// The class means and inverse pooled within-class variances of rows.
-fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) -> Fitted {
+fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) -> RowModel {
     let means = class_means(rows, dim, labels, classes);
     let mut variance = vec![0.0f64; dim];
     for (row, &l) in rows.chunks(dim).zip(labels) {
@@ -482,20 +490,31 @@ fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) ->
         .into_iter()
         .map(|v| if v / n > 1e-12 { n / v } else { 0.0 })
         .collect();
-    Fitted::NearestMean { means, weights }
+    RowModel::NearestMean { means, weights }
 }
 
 impl Fitted {
+    /// Adds one window's score for every class to `votes` (the network's
+    /// probabilities, or the row model's scores of its descriptor row).
+    fn add_votes(&self, descriptor: Descriptor, w: &FeatureSequence, fps: f64, votes: &mut [f32]) {
+        match self {
+            Fitted::ConvNet(net) => net.add_votes(w, votes),
+            Fitted::Rows(model) => model.add_votes(&descriptor_row(descriptor, w, fps), votes),
+        }
+    }
+}
+
+impl RowModel {
     /// Adds one window row's score for every class to `votes` (the forest's
     /// histogram, or minus the squared distance to each class mean).
     fn add_votes(&self, row: &[f32], votes: &mut [f32]) {
         match self {
-            Fitted::Forest(forest) => {
+            RowModel::Forest(forest) => {
                 for (v, h) in votes.iter_mut().zip(forest.predict(row)) {
                     *v += h;
                 }
             }
-            Fitted::NearestMean { means, weights } => {
+            RowModel::NearestMean { means, weights } => {
                 for (v, mean) in votes.iter_mut().zip(means) {
                     let d2: f64 = row
                         .iter()
@@ -506,7 +525,7 @@ impl Fitted {
                     *v -= d2 as f32;
                 }
             }
-            Fitted::Discriminant {
+            RowModel::Discriminant {
                 means,
                 scales,
                 precision,
@@ -522,7 +541,6 @@ impl Fitted {
                     *v -= z.dot(&(precision * &z)) as f32;
                 }
             }
-            Fitted::ConvNet(_) => unreachable!("the network votes on windows, not rows"),
         }
     }
 }
@@ -533,8 +551,8 @@ impl ClipClassifier {
         let mut classes: Vec<String> = clips.iter().map(|c| c.1.clone()).collect();
         classes.sort();
         classes.dedup();
+        // Every training window with its frame rate and class.
         let mut windows = Vec::new();
-        let mut rows = Vec::new();
         let mut labels = Vec::new();
         for (clip, label) in clips {
             let class = classes.binary_search(label).expect("listed") as u32;
@@ -544,27 +562,24 @@ impl ClipClassifier {
             }
             for m in &motions {
                 for w in feature_windows(m, config.windows)? {
-                    if config.model == Model::ConvNet {
-                        windows.push(w);
-                    } else {
-                        rows.extend(descriptor_row(config.descriptor, &w, m.fps()));
-                    }
+                    windows.push((w, m.fps()));
                     labels.push(class);
                 }
             }
         }
-        if config.model == Model::ConvNet {
-            let net = FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
-            return Ok(ClipClassifier {
-                config,
-                fitted: Fitted::ConvNet(Box::new(net)),
-                classes,
-            });
-        }
-        let dim = rows.len() / labels.len().max(1);
-        let samples = Samples::new(&rows, dim, &labels, classes.len()).map_err(invalid)?;
+        // The row models see one descriptor row per window.
+        let rows = || -> Vec<f32> {
+            windows
+                .iter()
+                .flat_map(|(w, fps)| descriptor_row(config.descriptor, w, *fps))
+                .collect()
+        };
+        let dim = |rows: &[f32]| rows.len() / labels.len().max(1);
         let fitted = match config.model {
             Model::Forest => {
+                let rows = rows();
+                let samples =
+                    Samples::new(&rows, dim(&rows), &labels, classes.len()).map_err(invalid)?;
                 let mut forest = ForestConfig {
                     trees: config.trees,
                     seed: config.seed,
@@ -573,13 +588,28 @@ impl ClipClassifier {
                 if let Some(c) = config.candidates {
                     forest.tree.candidates_per_node = Some(c);
                 }
-                Fitted::Forest(Forest::train(&samples, &forest, &|| {}))
+                Fitted::Rows(RowModel::Forest(Forest::train(&samples, &forest, &|| {})))
             }
-            Model::NearestMean => fit_nearest_mean(&rows, dim, &labels, classes.len()),
+            Model::NearestMean => {
+                let rows = rows();
+                Fitted::Rows(fit_nearest_mean(&rows, dim(&rows), &labels, classes.len()))
+            }
             Model::Discriminant => {
-                fit_discriminant(&rows, dim, &labels, classes.len(), config.shrinkage)?
+                let rows = rows();
+                Fitted::Rows(fit_discriminant(
+                    &rows,
+                    dim(&rows),
+                    &labels,
+                    classes.len(),
+                    config.shrinkage,
+                )?)
             }
-            Model::ConvNet => unreachable!("trained above"),
+            Model::ConvNet => {
+                let windows: Vec<FeatureSequence> = windows.into_iter().map(|(w, _)| w).collect();
+                let net =
+                    FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
+                Fitted::ConvNet(Box::new(net))
+            }
         };
         Ok(ClipClassifier {
             config,
@@ -588,17 +618,14 @@ impl ClipClassifier {
         })
     }
 
-    /// The class of a clip: the largest summed forest histogram over its
-    /// windows, or the nearest class mean on average over them.
+    /// The class of a clip: the largest summed score over its windows (forest
+    /// histograms, network probabilities, or minus the distances to the class
+    /// means).
     pub fn predict(&self, motion: &Motion) -> Result<String> {
         let mut votes = vec![0.0f32; self.classes.len()];
         for w in feature_windows(motion, self.config.windows)? {
-            if let Fitted::ConvNet(net) = &self.fitted {
-                net.add_votes(&w, &mut votes);
-            } else {
-                let row = descriptor_row(self.config.descriptor, &w, motion.fps());
-                self.fitted.add_votes(&row, &mut votes);
-            }
+            self.fitted
+                .add_votes(self.config.descriptor, &w, motion.fps(), &mut votes);
         }
         Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
     }
@@ -649,7 +676,7 @@ mod tests {
     fn nearest_mean_scales_by_the_within_class_spread() {
         // Value 0 separates the classes; value 1 is wide noise in both.
         let rows = [0.0f32, 10.0, 0.2, -10.0, 1.0, 10.0, 1.2, -10.0];
-        let Fitted::NearestMean { means, weights } = fit_nearest_mean(&rows, 2, &[0, 0, 1, 1], 2)
+        let RowModel::NearestMean { means, weights } = fit_nearest_mean(&rows, 2, &[0, 0, 1, 1], 2)
         else {
             panic!("nearest mean");
         };
@@ -674,7 +701,7 @@ mod tests {
                 labels.push(class);
             }
         }
-        let nearest = |fitted: &Fitted, row: &[f32]| {
+        let nearest = |fitted: &RowModel, row: &[f32]| {
             let mut votes = [0.0f32; 2];
             fitted.add_votes(row, &mut votes);
             mocap_search::forest::argmax(&votes)
@@ -687,7 +714,7 @@ mod tests {
         assert_eq!(nearest(&diagonal, &point), 1);
         let full = fit_discriminant(&rows, 2, &labels, 2, 0.01).unwrap();
         assert_eq!(nearest(&full, &point), 0);
-        let Fitted::Discriminant { precision, .. } = &full else {
+        let RowModel::Discriminant { precision, .. } = &full else {
             panic!("discriminant");
         };
         // inverse of [[1, r], [r, 1]] with r = 0.99 * 0.9.

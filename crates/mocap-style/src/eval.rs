@@ -939,10 +939,67 @@ fn draw_filmstrips(
     Ok(paths)
 }
 
+/// What a judge is, in words, for the report.
+fn judge_description(
+    model: Model,
+    descriptor: Descriptor,
+    trees: usize,
+    shrinkage: f64,
+    net: &NetConfig,
+) -> String {
+    let descriptor = match descriptor {
+        Descriptor::Intervals => "interval-means",
+        Descriptor::Statistics => "statistics",
+        Descriptor::Gait => "gait",
+        Descriptor::IntervalsGait => "interval-means + gait",
+    };
+    match model {
+        Model::Forest => format!("forest of {trees} trees on the {descriptor} descriptor"),
+        Model::NearestMean => format!("nearest class mean on the {descriptor} descriptor"),
+        Model::Discriminant => {
+            format!("linear discriminant (shrinkage {shrinkage}) on the {descriptor} descriptor")
+        }
+        Model::ConvNet => format!(
+            "conv net ({} channels, kernel {}, {} epochs) on the per-frame pose values{}",
+            net.width,
+            net.kernel,
+            net.epochs,
+            if net.velocities {
+                " and their changes"
+            } else {
+                ""
+            }
+        ),
+    }
+}
+
 impl EvalReport {
     /// The tables of the report in Markdown.
     pub fn to_markdown(&self) -> String {
-        let mut s = String::new();
+        let o = &self.options;
+        let mut s = format!(
+            "Judges (seed {}): style: {}{}; content: {}.\n\n",
+            o.seed,
+            judge_description(
+                o.style_model,
+                o.style_descriptor,
+                o.trees,
+                o.shrinkage,
+                &o.net
+            ),
+            if o.style_mirror_training {
+                ", trained on the mirror images of its clips too"
+            } else {
+                ""
+            },
+            judge_description(
+                o.content_model,
+                o.content_descriptor,
+                o.trees,
+                o.shrinkage,
+                &o.net
+            ),
+        );
         for set in &self.sets {
             s.push_str(&format!(
                 "### {}\n\n{} styles (chance {:.1}%), {} contents; classifiers trained on {} clips, \
