@@ -11,20 +11,14 @@
 # trains (${MODEL_DIR:-/tmp}/style-fold-first.safetensors). The per-run JSON
 # reports (about 1 MB each) stay in ${RUNS_DIR:-/tmp/style-judges}; the tables
 # go to bench/style/out/judges.md.
-set -euo pipefail
-cd "$(dirname "$0")/../.."
-DATA=${MOCAP_SHARED_DATA:-../shared/data}/bandai
-export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target-style}
-cargo build -q --profile test -p mocap-style --examples
-BIN=$CARGO_TARGET_DIR/debug/examples
-WALKS=walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right
+source "$(dirname "$0")/setup.sh"
 MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
 if [[ ! -f "$MODEL" ]]; then
   echo "needs the other fold's model $MODEL: run bash bench/style/run.sh --other-fold first" >&2
   exit 1
 fi
 RUNS=${RUNS_DIR:-/tmp/style-judges}
-mkdir -p "$RUNS" bench/style/out
+mkdir -p "$RUNS"
 for judge in forest conv-net; do
   if [[ $judge == conv-net ]]; then
     C_ARGS=(--style-model conv-net --net-velocities --mirror)
@@ -45,4 +39,4 @@ for judge in forest conv-net; do
     done
   done
 done
-python3 bench/style/judges_table.py "$RUNS" > bench/style/out/judges.md
+python3 bench/style/judges_table.py "$RUNS" > "$OUT/judges.md"

@@ -10,7 +10,10 @@
 //! the windows of the training clips, and a clip's label is the class with
 //! the largest summed forest histogram over its windows. With a few takes per
 //! style, windows give the forest many more samples, and the vote makes a
-//! clip's label robust to one odd stride.
+//! clip's label robust to one odd stride. [`Model::ConvNet`] is a second
+//! kind of judge on the same windows: a small conv net that reads the
+//! per-frame values themselves instead of a descriptor row
+//! ([`crate::classify_net`]).
 
 use mocap_core::Motion;
 use mocap_search::features::motion_features;
