@@ -29,7 +29,7 @@ use burn::optim::AdamConfig;
 use burn::tensor::activation::{relu, softmax};
 use burn::tensor::{Device, Int, Tensor, TensorData};
 use mocap_nn::device::seed_device;
-use mocap_nn::train::optimizer_step;
+use mocap_nn::train::{optimizer_step, work_bar};
 use mocap_search::intervals::FeatureSequence;
 use rand::rngs::ChaCha8Rng;
 use rand::seq::SliceRandom;
@@ -164,6 +164,8 @@ impl FittedNet {
             }
         }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        // Tens of seconds on a 2-core CPU: show it (hidden off a terminal).
+        let bar = work_bar(config.epochs as u64, "conv-net judge: training epochs");
         for _ in 0..config.epochs {
             let mut batches: Vec<Vec<usize>> = Vec::new();
             for members in by_length.values() {
@@ -193,7 +195,9 @@ impl FittedNet {
                 }
                 net = updated;
             }
+            bar.inc(1);
         }
+        bar.finish_and_clear();
         Ok(FittedNet {
             net: net.valid(),
             mean,
