@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Why restyled dataset-2 turns are read as straight walks (bench/results/style.md,
+# "The other fold"): the six right turns of the shipped fold that the active walk
+# (dataset-2_walk_active_031) made into "walks", restyled again with the shipped
+# model and `mocap style apply` (elastic patches, as the evaluation), then placed
+# between real straight walks and real right turns on the pose values that tell
+# those apart most (example feature_contrast); the sources the same way. About
+# a minute. Output: bench/style/out/turn-cues.md.
+source "$(dirname "$0")/setup.sh"
+cargo build -q --profile test -p mocap-cli
+MOCAP=$CARGO_TARGET_DIR/debug/mocap
+D2=$DATA/dataset-2
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+SOURCES=()
+for take in active_040 elderly_028 exhausted_037 feminine_031 normal_034 youthful_028; do
+  SOURCES+=("$D2/dataset-2_walk-turn-right_$take.bvh")
+  "$MOCAP" style apply "$D2/dataset-2_walk-turn-right_$take.bvh" \
+    --style "$D2/dataset-2_walk_active_031.bvh" -o "$TMP/$take.bvh" -q
+done
+{
+  echo "## Outputs (six right turns restyled with dataset-2_walk_active_031)"
+  echo
+  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/*.bvh --top 10
+  echo
+  echo "## Their sources"
+  echo
+  "$BIN/feature_contrast" "$D2" walk-turn-right walk "${SOURCES[@]}" --top 10
+} > "$OUT/turn-cues.md"
