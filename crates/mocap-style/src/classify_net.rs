@@ -163,6 +163,11 @@ impl FittedNet {
                 by_length.entry(w.frame_count()).or_default().push(i);
             }
         }
+        if by_length.is_empty() {
+            return Err(invalid(format!(
+                "classifier: no training window has the {MIN_FRAMES} frames the network needs"
+            )));
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         // Tens of seconds on a 2-core CPU: show it (hidden off a terminal).
         let bar = work_bar(config.epochs as u64, "conv-net judge: training epochs");
@@ -335,6 +340,13 @@ mod tests {
             ..NetConfig::default()
         };
         let net = FittedNet::train(&windows, &labels, 2, &config, 3).unwrap();
+        // Windows too short for the network are refused, not learnt from
+        // silently.
+        let short = FeatureSequence {
+            dim: 2,
+            values: vec![0.0; 6],
+        };
+        assert!(FittedNet::train(&[short], &[0], 2, &config, 3).is_err());
         for (phase, class) in [(2.0, 0), (5.1, 0), (1.3, 1), (4.4, 1)] {
             let mut votes = [0.0f32; 2];
             let frequency = if class == 0 { 0.2 } else { 0.9 };
