@@ -20,17 +20,12 @@ fi
 RUNS=${RUNS_DIR:-/tmp/style-judges}
 mkdir -p "$RUNS"
 for judge in forest conv-net; do
-  if [[ $judge == conv-net ]]; then
-    C_ARGS=(--style-model conv-net --net-velocities --mirror)
-  else
-    C_ARGS=(--style-model forest)
-  fi
   for seed in 1 2 3; do
     for fold in last first; do
       FOLD_ARGS=(--held-out "$fold")
       [[ $fold == first ]] && FOLD_ARGS+=(--model "$MODEL")
       "$BIN/classifiers" --held-out "$fold" --seed "$seed" --cv-style \
-        --classifier-contents "$WALKS" "${C_ARGS[@]}" "$DATA/dataset-1" \
+        --classifier-contents "$WALKS" --style-judge "$judge" "$DATA/dataset-1" \
         > "$RUNS/classifiers-$judge-$fold-seed$seed.json"
       "$BIN/style_eval" "${FOLD_ARGS[@]}" --style-judge "$judge" --seed "$seed" \
         --sources walk,walk-turn-left,walk-turn-right --styles walk \

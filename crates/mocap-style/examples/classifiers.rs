@@ -6,7 +6,7 @@
 //! cargo run -p mocap-style --example classifiers -- [--cv | --cv-style | --cv-content] \
 //!     [--classifier-contents walk,walk-back] [--style-descriptor gait] \
 //!     [--content-descriptor intervals-gait] [--style-window 2] [--content-window 2] \
-//!     [--style-model forest|nearest-mean|discriminant|conv-net] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
+//!     [--style-model forest|nearest-mean|discriminant|conv-net] [--style-judge forest|conv-net] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
 //!     [--net-epochs 30] [--net-width 64] [--net-kernel 7] [--net-dropout 0.3] [--net-lr 0.001] [--net-velocities] DIR...
 //! ```
 
@@ -41,6 +41,7 @@ fn main() {
                 options.content_windows.length = value().parse().expect("seconds")
             }
             "--style-model" => options.style_model = descriptor(value()),
+            "--style-judge" => options.set_style_judge(value().parse().expect("--style-judge")),
             "--content-model" => options.content_model = descriptor(value()),
             "--shrinkage" => options.shrinkage = value().parse().expect("shrinkage"),
             "--seed" => options.seed = value().parse().expect("seed"),

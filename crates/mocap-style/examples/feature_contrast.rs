@@ -9,7 +9,8 @@
 //! ```
 //!
 //! Every clip of `DIR` whose labels say `CONTENT_A` or `CONTENT_B` gives the
-//! mean and the deviation over its frames of each of the 56 pose values. A
+//! mean and the deviation over its frames of each of the judges' pose values
+//! (`mocap_style::classify::clip_pose_statistics`). A
 //! value's separation is the difference of the two contents' averages over
 //! their clips, in units of the pooled spread between clips; the values that
 //! separate most are printed with the average of `FILE...` placed on the
@@ -18,27 +19,18 @@
 use std::path::{Path, PathBuf};
 
 use mocap_core::io::read_motion;
-use mocap_search::features::{motion_features, VALUE_NAMES};
+use mocap_search::features::VALUE_NAMES;
+use mocap_style::classify::clip_pose_statistics;
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-
-/// The 56 pose values the evaluation's judges read.
-const POSE_VALUES: usize = 56;
 
 /// Per clip: the mean, then the deviation, of every pose value over its frames.
 fn clip_statistics(path: &Path) -> Vec<f64> {
     let motion = read_motion(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let features = motion_features(&motion).expect("pose values");
-    let (n, d) = (features.frame_count(), features.dim);
-    let values = &features.values;
-    let column = |i: usize| (0..n).map(move |t| values[t * d + i] as f64);
-    let means: Vec<f64> = (0..POSE_VALUES)
-        .map(|i| column(i).sum::<f64>() / n as f64)
-        .collect();
-    let deviations = (0..POSE_VALUES)
-        .map(|i| (column(i).map(|v| (v - means[i]).powi(2)).sum::<f64>() / n as f64).sqrt());
-    let mut row = means.clone();
-    row.extend(deviations);
-    row
+    clip_pose_statistics(&motion)
+        .expect("pose values")
+        .into_iter()
+        .map(f64::from)
+        .collect()
 }
 
 /// Average and spread over clips of statistic `k`.
@@ -81,7 +73,9 @@ fn main() {
         !clips_a.is_empty() && !clips_b.is_empty() && !others.is_empty(),
         "no clips"
     );
-    let mut rows: Vec<(f64, String)> = (0..2 * POSE_VALUES)
+    // Means first, then deviations, of the pose values.
+    let pose_values = clips_a[0].len() / 2;
+    let mut rows: Vec<(f64, String)> = (0..2 * pose_values)
         .map(|k| {
             let (mean_a, spread_a) = average(&clips_a, k);
             let (mean_b, spread_b) = average(&clips_b, k);
@@ -89,8 +83,8 @@ fn main() {
             let pooled = ((spread_a.powi(2) + spread_b.powi(2)) / 2.0).sqrt().max(1e-12);
             let separation = (mean_a - mean_b) / pooled;
             let place = (mean_o - mean_b) / (mean_a - mean_b);
-            let what = if k < POSE_VALUES { "mean" } else { "deviation" };
-            let name = VALUE_NAMES[k % POSE_VALUES];
+            let what = if k < pose_values { "mean" } else { "deviation" };
+            let name = VALUE_NAMES[k % pose_values];
             (
                 separation.abs(),
                 format!(

@@ -119,6 +119,13 @@ fn pose_values(motion: &Motion) -> Result<FeatureSequence> {
     })
 }
 
+/// The mean and then the standard deviation, over all frames of a clip, of
+/// each of the pose values the judges read (what
+/// [`Descriptor::Statistics`] sees of a window, for the whole clip).
+pub fn clip_pose_statistics(motion: &Motion) -> Result<Vec<f32>> {
+    Ok(statistics_row(&pose_values(motion)?))
+}
+
 /// Mean and standard deviation of every feature over a window.
 pub(crate) fn statistics_row(w: &FeatureSequence) -> Vec<f32> {
     let n = w.frame_count().max(1) as f64;

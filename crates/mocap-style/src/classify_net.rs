@@ -147,9 +147,13 @@ impl FittedNet {
             .iter()
             .map(|w| net_input(w, config.velocities))
             .collect();
-        let windows = &inputs[..];
-        let dim = windows[0].dim;
-        let (mean, scale) = standardisation(windows, dim);
+        let dim = inputs[0].dim;
+        let (mean, scale) = standardisation(&inputs, dim);
+        // Standardised once here, not again in every epoch's batches.
+        let windows: Vec<FeatureSequence> = inputs
+            .iter()
+            .map(|w| standardised(w, &mean, &scale))
+            .collect();
         let device = Device::flex().autodiff();
         seed_device(&device, seed);
         let mut net = WindowNet::new(dim, classes, config, &device);
@@ -181,13 +185,7 @@ impl FittedNet {
             batches.shuffle(&mut rng);
             for batch in batches {
                 let frames = windows[batch[0]].frame_count();
-                let x = input_tensor(
-                    batch.iter().map(|&i| &windows[i]),
-                    frames,
-                    &mean,
-                    &scale,
-                    &device,
-                );
+                let x = input_tensor(batch.iter().map(|&i| &windows[i]), frames, &device);
                 let targets: Vec<i64> = batch.iter().map(|&i| labels[i] as i64).collect();
                 let targets =
                     Tensor::<1, Int>::from_data(TensorData::new(targets, [batch.len()]), &device);
@@ -218,14 +216,8 @@ impl FittedNet {
         if frames < MIN_FRAMES {
             return;
         }
-        let window = net_input(window, self.velocities);
-        let x = input_tensor(
-            std::iter::once(&window),
-            frames,
-            &self.mean,
-            &self.scale,
-            &self.device,
-        );
+        let window = standardised(&net_input(window, self.velocities), &self.mean, &self.scale);
+        let x = input_tensor(std::iter::once(&window), frames, &self.device);
         let p = softmax(self.net.forward(x), 1).into_data();
         let p: Vec<f32> = p.try_to_vec().expect("f32 probabilities");
         for (v, q) in votes.iter_mut().zip(p) {
@@ -287,22 +279,39 @@ fn standardisation(windows: &[FeatureSequence], dim: usize) -> (Vec<f32>, Vec<f3
     (mean, scale)
 }
 
-/// `[windows, values, frames]`, standardised.
+/// `(v - mean) * scale` for every value of every frame.
+fn standardised(window: &FeatureSequence, mean: &[f32], scale: &[f32]) -> FeatureSequence {
+    let values = window
+        .values
+        .chunks(window.dim)
+        .flat_map(|frame| {
+            frame
+                .iter()
+                .zip(mean)
+                .zip(scale)
+                .map(|((v, m), s)| (v - m) * s)
+        })
+        .collect();
+    FeatureSequence {
+        dim: window.dim,
+        values,
+    }
+}
+
+/// `[windows, values, frames]` of windows of `frames` frames (channels
+/// first, as the convolutions read them).
 fn input_tensor<'a>(
     windows: impl Iterator<Item = &'a FeatureSequence>,
     frames: usize,
-    mean: &[f32],
-    scale: &[f32],
     device: &Device,
 ) -> Tensor<3> {
-    let dim = mean.len();
     let mut data = Vec::new();
     let mut count = 0;
+    let mut dim = 0;
     for w in windows {
+        dim = w.dim;
         for i in 0..dim {
-            for f in 0..frames {
-                data.push((w.values[f * dim + i] - mean[i]) * scale[i]);
-            }
+            data.extend((0..frames).map(|f| w.values[f * dim + i]));
         }
         count += 1;
     }

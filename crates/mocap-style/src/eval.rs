@@ -127,7 +127,7 @@ impl std::str::FromStr for StyleJudge {
 
 impl EvalOptions {
     /// Judges style with `judge` in the setting measured for it on real
-    /// clips (bench/results/style.md, "A small conv-net judge").
+    /// clips (bench/results/style.md, "A second judge: a small conv net").
     pub fn set_style_judge(&mut self, judge: StyleJudge) {
         match judge {
             StyleJudge::Forest => {
