@@ -39,7 +39,9 @@ use serde::{Deserialize, Serialize};
 use crate::contact::{
     clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions, RootShift,
 };
-use crate::convert::{convert, Conversion, ConvertOptions, Latents, Method, RootPath, StyleInput};
+use crate::convert::{
+    convert, Asymmetry, Conversion, ConvertOptions, Latents, Method, RootPath, StyleInput,
+};
 use crate::data::mirrored;
 use crate::features::{compose, decompose, sample_frames, RootTrack};
 use crate::train::StyleModel;
@@ -71,6 +73,10 @@ pub struct ApplyOptions {
     /// ([`crate::contact::clean_foot_contacts`]).
     #[serde(default)]
     pub foot_contacts: bool,
+    /// Whose left-right asymmetry the output keeps (default: the source's,
+    /// so turns stay turns; [`Asymmetry`]).
+    #[serde(default)]
+    pub asymmetry: Asymmetry,
     pub device: DeviceChoice,
 }
 
@@ -92,6 +98,7 @@ impl ApplyOptions {
             blend: None,
             patch: ConvertOptions::default().patch,
             root: RootPath::default(),
+            asymmetry: Asymmetry::default(),
             foot_contacts: false,
             device: DeviceChoice::Cpu,
         }
@@ -254,10 +261,20 @@ pub fn restyle(
                 .collect()
         })
         .collect();
+    // The mirror image's codes, for the source's asymmetry (convert.rs,
+    // step 6).
+    let mirror_features = match options.asymmetry {
+        Asymmetry::Source => {
+            let (mirror_rotations, _) = decompose(&mirrored(&src)?, rig);
+            Some(model.features(&mirror_rotations))
+        }
+        Asymmetry::Style => None,
+    };
     timings.prepare += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let latents = model.encode(&features)?;
+    let mirror_latents = mirror_features.map(|f| model.encode(&f)).transpose()?;
     timings.encode += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -269,7 +286,13 @@ pub fn restyle(
             weight: *w,
         })
         .collect();
-    let conversion = convert(&latents, &root.heights(), &inputs, options)?;
+    let conversion = convert(
+        &latents,
+        mirror_latents.as_ref(),
+        &root.heights(),
+        &inputs,
+        options,
+    )?;
     timings.matching += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -337,6 +360,7 @@ pub struct ApplyReport {
     /// horizontally (file units, on the model's rig).
     pub root_shift: RootShift,
     pub foot_contacts: bool,
+    pub asymmetry: Asymmetry,
     pub source_frames: usize,
     pub output_frames: usize,
     pub fps: f64,
@@ -517,6 +541,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         fade_in_frames: (options.fade_in_seconds * model.description.fps) as f32,
         root: options.root,
         foot_contacts: options.foot_contacts,
+        asymmetry: options.asymmetry,
         ..ConvertOptions::default()
     };
     let restyled = restyle(&model, &source_on_rig, &styles, &convert_options, timings)?;
@@ -561,6 +586,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         root: options.root,
         root_shift: restyled.root_shift,
         foot_contacts: options.foot_contacts,
+        asymmetry: options.asymmetry,
         source_frames: source.frame_count(),
         output_frames: output.frame_count(),
         fps: output.fps(),

@@ -30,6 +30,20 @@
 //!    where `s = 0` and at the style's where `s = 1`, so at strength 0.5 an
 //!    elastic output lasts about halfway between the source and the full
 //!    style.
+//! 6. Asymmetry (not in the report; [`Asymmetry::Source`], the default):
+//!    the output latent gets `s(t) (m_x - m_x~) / 2`, half the difference
+//!    between the mean latent code of the source and that of its mirror
+//!    image. Colouring gives the output the style's mean, which is
+//!    left-right symmetric since the style's statistics cover its clip and
+//!    its mirror; but a turn's lean and sideways footwork, or a sidestep,
+//!    lie partly in the mean (the left leg held differently from the
+//!    right), and with the style's mean and a straight walk's patches a
+//!    turn came out as a straight walk. The half-difference is the part of
+//!    the source's mean that mirroring flips: about zero for a straight walk
+//!    (over whole strides the mirror shows the same poses half a stride
+//!    later), so walks are left as before, and it carries which way and how
+//!    hard the source turns. [`Asymmetry::Style`] leaves it out (the
+//!    report's method).
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
 //! the whitened source frames with the style's statistics without any
@@ -161,6 +175,41 @@ impl std::str::FromStr for RootPath {
     }
 }
 
+/// Whose left-right asymmetry the output's mean pose keeps (step 6 of the
+/// module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Asymmetry {
+    /// The source's: the part of its mean latent code that mirroring flips
+    /// is added to the output, so turns and sidesteps keep their direction.
+    #[default]
+    Source,
+    /// The style's (symmetric) mean alone: the report's method.
+    Style,
+}
+
+impl Asymmetry {
+    pub const ALL: [Asymmetry; 2] = [Asymmetry::Source, Asymmetry::Style];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Asymmetry::Source => "source",
+            Asymmetry::Style => "style",
+        }
+    }
+}
+
+impl std::str::FromStr for Asymmetry {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        Asymmetry::ALL
+            .into_iter()
+            .find(|a| a.name() == s)
+            .ok_or_else(|| format!("unknown asymmetry `{s}` (expected source or style)"))
+    }
+}
+
 /// How the source's latent codes are converted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -232,6 +281,9 @@ pub struct ConvertOptions {
     /// [`crate::apply::restyle`] after decoding, before `foot_contacts`.
     #[serde(default)]
     pub root: RootPath,
+    /// Whose left-right asymmetry the output keeps ([`Asymmetry`]).
+    #[serde(default)]
+    pub asymmetry: Asymmetry,
 }
 
 impl Default for ConvertOptions {
@@ -245,6 +297,7 @@ impl Default for ConvertOptions {
             fade_in_frames: 0.0,
             foot_contacts: false,
             root: RootPath::default(),
+            asymmetry: Asymmetry::default(),
         }
     }
 }
@@ -406,8 +459,12 @@ struct PreparedStyle<'a> {
 
 /// Converts `source` (latent codes and root height per frame) to the
 /// styles. Weights of the styles are normalised to sum to one.
+/// `source_mirror` holds the latent codes of the source's mirror image,
+/// frame by frame; [`Asymmetry::Source`] needs it, [`Asymmetry::Style`]
+/// ignores it.
 pub fn convert(
     source: &Latents,
+    source_mirror: Option<&Latents>,
     source_height: &[f32],
     styles: &[StyleInput],
     options: &ConvertOptions,
@@ -466,6 +523,23 @@ pub fn convert(
             bank,
         });
     }
+    let asymmetry = match (options.asymmetry, source_mirror) {
+        (Asymmetry::Style, _) => vec![0.0; dim],
+        (Asymmetry::Source, Some(mirror)) => {
+            if mirror.dim != dim || mirror.frames != source.frames {
+                return Err(invalid(format!(
+                    "internal: the source's mirror has {} frames of {} values, the source {} of {}",
+                    mirror.frames, mirror.dim, source.frames, dim
+                )));
+            }
+            mirror_antisymmetric_mean(source, mirror)
+        }
+        (Asymmetry::Source, None) => {
+            return Err(invalid(
+                "internal: keeping the source's asymmetry needs the latent codes of its mirror",
+            ))
+        }
+    };
     let source_stats = Statistics::of_rows([source.data.as_slice()], dim);
     let source_white = source.whitened(&source_stats);
 
@@ -561,7 +635,7 @@ pub fn convert(
         source.sample(u, &mut x);
         for c in 0..dim {
             let y = (1.0 - a) * converted[o * dim + c] + a * converted[next * dim + c];
-            data[q * dim + c] = (1.0 - s) * x[c] + s * y;
+            data[q * dim + c] = (1.0 - s) * x[c] + s * (y + asymmetry[c]);
         }
         let y_height = (1.0 - a) * converted_height[o] + a * converted_height[next];
         height[q] = (1.0 - s) * sample_track(source_height, u) + s * y_height;
@@ -581,6 +655,23 @@ pub fn convert(
         strength,
         matches,
     })
+}
+
+/// Step 6: `(m_x - m_x~) / 2`, the part of the source's mean latent code
+/// that mirroring flips.
+fn mirror_antisymmetric_mean(source: &Latents, mirror: &Latents) -> Vec<f32> {
+    let mut half_difference = vec![0.0f64; source.dim];
+    for (x, m) in source
+        .data
+        .chunks_exact(source.dim)
+        .zip(mirror.data.chunks_exact(source.dim))
+    {
+        for c in 0..source.dim {
+            half_difference[c] += 0.5 * (x[c] as f64 - m[c] as f64);
+        }
+    }
+    let n = source.frames.max(1) as f64;
+    half_difference.iter().map(|d| (d / n) as f32).collect()
 }
 
 fn mean_height(sequences: &[(Latents, Vec<f32>)]) -> f32 {
@@ -735,6 +826,9 @@ fn swap_patches(source: &Latents, styles: &[PreparedStyle], options: &ConvertOpt
 mod tests {
     use super::*;
 
+    // The sources of these tests are passed as their own mirror images: no
+    // asymmetry to keep (step 6), unless a test says otherwise.
+
     /// A latent sequence of a gait-like signal with period `period` frames.
     fn periodic(frames: usize, period: f32, phase: f32) -> Latents {
         let dim = 6;
@@ -797,6 +891,7 @@ mod tests {
         };
         let c = convert(
             &x,
+            Some(&x),
             &h,
             &[StyleInput {
                 sequences: &seqs,
@@ -825,7 +920,7 @@ mod tests {
             sequences: &y,
             weight: 1.0,
         }];
-        let elastic = convert(&x, &h, &style, &ConvertOptions::default()).unwrap();
+        let elastic = convert(&x, Some(&x), &h, &style, &ConvertOptions::default()).unwrap();
         let ratio = elastic.latents.frames as f32 / 300.0;
         assert!(
             (ratio - 38.0 / 30.0).abs() < 0.1,
@@ -836,6 +931,7 @@ mod tests {
         assert!(*elastic.source_time.last().unwrap() > 290.0);
         let fixed = convert(
             &x,
+            Some(&x),
             &h,
             &style,
             &ConvertOptions {
@@ -857,6 +953,7 @@ mod tests {
         let at = |strength: f32| {
             convert(
                 &x,
+                Some(&x),
                 &h,
                 &style,
                 &ConvertOptions {
@@ -907,14 +1004,14 @@ mod tests {
             strength: 0.0,
             ..ConvertOptions::default()
         };
-        let c = convert(&x, &h, &style, &options).unwrap();
+        let c = convert(&x, Some(&x), &h, &style, &options).unwrap();
         assert_eq!(c.latents.data, x.data);
         let fade = ConvertOptions {
             strength: 0.8,
             fade_in_frames: 60.0,
             ..options
         };
-        let c = convert(&x, &h, &style, &fade).unwrap();
+        let c = convert(&x, Some(&x), &h, &style, &fade).unwrap();
         assert_eq!(c.strength[0], 0.0);
         assert!((c.strength[30] - 0.4).abs() < 1e-5);
         assert!((c.strength[100] - 0.8).abs() < 1e-5);
@@ -936,6 +1033,7 @@ mod tests {
             };
             let c = convert(
                 &x,
+                Some(&x),
                 &h,
                 &[StyleInput {
                     sequences: &ys,
@@ -953,12 +1051,62 @@ mod tests {
         }
     }
 
+    /// Step 6: a source held off-centre by `d` (its mirror by `-d`, half a
+    /// stride later) comes out `strength * d` away from the same conversion
+    /// with the style's symmetric mean, at every frame and for every method;
+    /// without its mirror it is refused.
+    #[test]
+    fn the_source_asymmetry_is_kept() {
+        let d = [0.3f32, -0.2, 0.0, 0.1, 0.0, 0.05];
+        let offset = |l: Latents, sign: f32| {
+            let data = (l.data.iter().enumerate())
+                .map(|(i, v)| v + sign * d[i % l.dim])
+                .collect();
+            Latents::new(l.frames, l.dim, data).unwrap()
+        };
+        // 300 frames are ten whole strides, so the mirror's stride-average
+        // equals the source's and the half-difference of the means is `d`.
+        let x = offset(periodic(300, 30.0, 0.0), 1.0);
+        let mirror = offset(periodic(300, 30.0, std::f32::consts::PI), -1.0);
+        let h = vec![90.0; 300];
+        let y = style_of(periodic(240, 38.0, 0.0));
+        let style = [StyleInput {
+            sequences: &y,
+            weight: 1.0,
+        }];
+        for method in Method::ALL {
+            let kept = ConvertOptions {
+                method,
+                strength: 0.6,
+                ..ConvertOptions::default()
+            };
+            let symmetric = ConvertOptions {
+                asymmetry: Asymmetry::Style,
+                ..kept
+            };
+            let a = convert(&x, Some(&mirror), &h, &style, &kept).unwrap();
+            let b = convert(&x, None, &h, &style, &symmetric).unwrap();
+            assert_eq!(a.latents.frames, b.latents.frames, "{method:?}");
+            for (i, (u, v)) in a.latents.data.iter().zip(&b.latents.data).enumerate() {
+                let want = 0.6 * d[i % 6];
+                assert!(
+                    (u - v - want).abs() < 1e-4,
+                    "{method:?}: {} != {want}",
+                    u - v
+                );
+            }
+            let err = convert(&x, None, &h, &style, &kept).unwrap_err();
+            assert!(err.to_string().contains("mirror"), "{err}");
+        }
+    }
+
     #[test]
     fn a_style_clip_shorter_than_a_patch_is_an_error() {
         let x = periodic(100, 30.0, 0.0);
         let y = style_of(periodic(20, 30.0, 0.0));
         let err = convert(
             &x,
+            Some(&x),
             &vec![90.0; 100],
             &[StyleInput {
                 sequences: &y,

@@ -23,7 +23,9 @@
 //!    matching, so the style's timing replaces the source's; a second series
 //!    of patches offset by half a patch is blended in linearly so there are
 //!    no seams. Strength, fade-in and a blend of two styles are latent
-//!    interpolations.
+//!    interpolations. Beyond the report, the output keeps the part of the
+//!    source's mean latent code that mirroring flips, so a turn stays a
+//!    turn ([`convert::Asymmetry`]).
 //!    [`contact`] can pin the feet during ground contacts afterwards
 //!    (opt-in).
 //! 4. [`apply`]: the whole thing on files (`mocap style apply`); [`eval`]

@@ -302,3 +302,71 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     }
     assert!(wrong.len() <= 1, "{wrong:?}");
 }
+
+/// Restyled turns keep their turn. In a right turn the feet land to one
+/// side of the pelvis (in the body's own frame), where a straight walk's
+/// are about centred; the style's symmetric statistics and a straight
+/// walk's patches centred them (bench/results/style.md, "Turns kept").
+/// Keeping the source's left-right asymmetry (the default) brings the
+/// output's mean sideways foot offset back towards the source's. Six
+/// held-out right turns of six styles, restyled with a held-out straight
+/// walk.
+#[test]
+fn restyled_turns_keep_their_sideways_footwork() {
+    use mocap_search::features::VALUE_NAMES;
+    use mocap_style::classify::clip_pose_statistics;
+    use mocap_style::convert::Asymmetry;
+
+    let index = |name: &str| VALUE_NAMES.iter().position(|n| *n == name).unwrap();
+    let (left, right) = (index("left_ankle.x"), index("right_ankle.x"));
+    // Mean over frames of the two ankles' sideways offsets from the pelvis.
+    let feet_offset = |motion: &mocap_core::Motion| {
+        let statistics = clip_pose_statistics(motion).unwrap();
+        statistics[left] + statistics[right]
+    };
+    let Some(sty) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
+        return;
+    };
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let mut t = StageTimings::default();
+    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
+    let mut errors = [0.0f32; 2];
+    for take in [
+        "active_040",
+        "elderly_028",
+        "exhausted_037",
+        "feminine_031",
+        "normal_034",
+        "youthful_028",
+    ] {
+        let name = format!("dataset-2_walk-turn-right_{take}.bvh");
+        let Some(src) = bandai("dataset-2", &name) else {
+            return;
+        };
+        let source = read_bvh(&src).unwrap();
+        let wanted = feet_offset(&source);
+        for (k, asymmetry) in [Asymmetry::Source, Asymmetry::Style]
+            .into_iter()
+            .enumerate()
+        {
+            let options = ConvertOptions {
+                asymmetry,
+                ..ConvertOptions::default()
+            };
+            let out = restyle(&model, &source, &[(&clip, 1.0)], &options, t).unwrap();
+            let got = feet_offset(&out.motion);
+            eprintln!("{take} {asymmetry:?}: feet offset {got:.4}, source {wanted:.4}");
+            errors[k] += (got - wanted).abs() / 6.0;
+        }
+    }
+    eprintln!(
+        "mean |output - source|: kept {:.4}, style's {:.4}",
+        errors[0], errors[1]
+    );
+    assert!(
+        errors[0] < 0.25 * errors[1],
+        "feet offset error {} with the source's asymmetry, {} without",
+        errors[0],
+        errors[1]
+    );
+}

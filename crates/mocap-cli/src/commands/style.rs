@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context};
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::{Method, RootPath};
+use mocap_style::convert::{Asymmetry, Method, RootPath};
 use mocap_style::data::HeldOutTake;
 use mocap_style::eval::{evaluate, EvalOptions, StyleJudge};
 use mocap_style::train::{train, TrainOptions};
@@ -123,6 +123,11 @@ struct ApplyArgs {
     /// some style, see bench/results/style.md).
     #[arg(long)]
     foot_contacts: bool,
+    /// Whose left-right asymmetry the output keeps: `source` (default: a turn or a sidestep
+    /// keeps its direction and lean) or `style` (the style's symmetric mean alone: the
+    /// report's method, which restyles turns into near-straight walks).
+    #[arg(long, value_name = "source|style", default_value = "source")]
+    asymmetry: Asymmetry,
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
     #[arg(long)]
@@ -165,6 +170,9 @@ struct EvalArgs {
     /// Restyle with the ankles pinned on the ground (as `apply --foot-contacts`).
     #[arg(long)]
     foot_contacts: bool,
+    /// Whose left-right asymmetry the outputs keep, as `apply --asymmetry`.
+    #[arg(long, value_name = "source|style", default_value = "source")]
+    asymmetry: Asymmetry,
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
     trees: usize,
@@ -264,6 +272,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 a.root
             };
             apply_options.foot_contacts = a.foot_contacts;
+            apply_options.asymmetry = a.asymmetry;
             apply_options.device = a.device;
             let report = apply(&apply_options)?;
             if a.json {
@@ -312,6 +321,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 a.root
             };
             eval_options.convert.foot_contacts = a.foot_contacts;
+            eval_options.convert.asymmetry = a.asymmetry;
             eval_options.set_style_judge(a.style_judge);
             eval_options.seed = a.judge_seed;
             let report = evaluate(&eval_options)?;
