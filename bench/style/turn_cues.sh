@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Why restyled dataset-2 turns are read as straight walks (bench/results/style.md,
-# "The other fold"): the six right turns of the shipped fold that the active walk
-# (dataset-2_walk_active_031) made into "walks", restyled again with the shipped
-# model and `mocap style apply` (elastic patches, as the evaluation), then placed
-# between real straight walks and real right turns on the pose values that tell
-# those apart most (example feature_contrast); the sources the same way. About
-# a minute. Output: bench/style/out/turn-cues.md.
+# Why restyled dataset-2 turns were read as straight walks (bench/results/style.md,
+# "The other fold" and "Turns kept"): the six right turns of the shipped fold that
+# the active walk (dataset-2_walk_active_031) made into "walks" before session 16,
+# restyled again with the shipped model and `mocap style apply` (elastic patches,
+# as the evaluation), with the source's left-right asymmetry kept (the default)
+# and without it (`--asymmetry style`, the report's method), then placed between
+# real straight walks and real right turns on the pose values that tell those
+# apart most (example feature_contrast); the sources the same way. About a
+# minute. Output: bench/style/out/turn-cues.md.
 source "$(dirname "$0")/setup.sh"
 cargo build -q --profile test -p mocap-cli
 MOCAP=$CARGO_TARGET_DIR/debug/mocap
@@ -13,15 +15,22 @@ D2=$DATA/dataset-2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 SOURCES=()
+mkdir -p "$TMP/source" "$TMP/style"
 for take in active_040 elderly_028 exhausted_037 feminine_031 normal_034 youthful_028; do
   SOURCES+=("$D2/dataset-2_walk-turn-right_$take.bvh")
-  "$MOCAP" style apply "$D2/dataset-2_walk-turn-right_$take.bvh" \
-    --style "$D2/dataset-2_walk_active_031.bvh" -o "$TMP/$take.bvh" -q
+  for asymmetry in source style; do
+    "$MOCAP" style apply "$D2/dataset-2_walk-turn-right_$take.bvh" --asymmetry "$asymmetry" \
+      --style "$D2/dataset-2_walk_active_031.bvh" -o "$TMP/$asymmetry/$take.bvh" -q
+  done
 done
 {
   echo "## Outputs (six right turns restyled with dataset-2_walk_active_031)"
   echo
-  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/*.bvh --top 10
+  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/source/*.bvh --top 10
+  echo
+  echo "## The same without the source's asymmetry (--asymmetry style, the report's method)"
+  echo
+  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/style/*.bvh --top 10
   echo
   echo "## Their sources"
   echo

@@ -7,7 +7,9 @@
 //! The source is cut (or its frames used) to its first 10 seconds; each run
 //! prepares and encodes the style clip and its mirror, then restyles, as
 //! `mocap style apply` does (file reading and writing excluded). Prints the
-//! median of every stage over the runs, for elastic and fixed patches.
+//! median of every stage over the runs, for elastic and fixed patches, the
+//! three roots, and without the source's asymmetry (which encodes the
+//! source's mirror too).
 
 use std::path::PathBuf;
 
@@ -17,7 +19,7 @@ use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{
     load_model, prepare_style, restyle, source_reconstruction_deg, StageTimings,
 };
-use mocap_style::convert::{ConvertOptions, Method, RootPath};
+use mocap_style::convert::{Asymmetry, ConvertOptions, Method, RootPath};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -57,11 +59,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| method | total (ms) | prepare | encode | match | decode | compose | output frames |"
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
-    for (method, root) in [
-        (Method::ElasticPatches, RootPath::FeetAlongSource),
-        (Method::FixedPatches, RootPath::FeetAlongSource),
-        (Method::ElasticPatches, RootPath::Source),
-        (Method::ElasticPatches, RootPath::Feet),
+    for (method, root, asymmetry) in [
+        (
+            Method::ElasticPatches,
+            RootPath::FeetAlongSource,
+            Asymmetry::Source,
+        ),
+        (
+            Method::FixedPatches,
+            RootPath::FeetAlongSource,
+            Asymmetry::Source,
+        ),
+        (Method::ElasticPatches, RootPath::Source, Asymmetry::Source),
+        (Method::ElasticPatches, RootPath::Feet, Asymmetry::Source),
+        (
+            Method::ElasticPatches,
+            RootPath::FeetAlongSource,
+            Asymmetry::Style,
+        ),
     ] {
         let mut all: Vec<StageTimings> = Vec::new();
         let mut out_frames = 0;
@@ -71,6 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let options = ConvertOptions {
                 method,
                 root,
+                asymmetry,
                 ..ConvertOptions::default()
             };
             let r = restyle(&model, &source, &[(&clip, 1.0)], &options, t)?;
@@ -82,9 +98,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let total = ms(&|t| t.total());
         let share = |v: f64| format!("{v:.1} ms ({:.0}%)", 100.0 * v / total);
         println!(
-            "| {}, root {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| {}, root {}, asymmetry {} | {:.1} | {} | {} | {} | {} | {} | {} |",
             method.name(),
             root.name(),
+            asymmetry.name(),
             total,
             share(ms(&|t| t.prepare)),
             share(ms(&|t| t.encode)),

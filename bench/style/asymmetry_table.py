@@ -1,0 +1,49 @@
+"""Before/after table of bench/style/asymmetry.sh: every method on both folds,
+with the source's left-right asymmetry kept (the default, eval.json) and
+without it (`--asymmetry style`, the report's method).
+
+Usage: python3 bench/style/asymmetry_table.py RUNS_DIR > bench/style/out/asymmetry.md
+RUNS_DIR holds eval-last.json and eval-first.json of `--asymmetry style`.
+"""
+import json
+import pathlib
+import sys
+
+OUT = pathlib.Path(__file__).resolve().parent / "out"
+RUNS_DIR = pathlib.Path(sys.argv[1])
+RUNS = {
+    "style (report)": (RUNS_DIR / "eval-last.json", RUNS_DIR / "eval-first.json"),
+    "source (default)": (OUT / "eval.json", OUT / "fold-first/eval.json"),
+}
+METHODS = ["elastic-patches", "fixed-patches", "whitening-colouring", "adain"]
+
+
+def method_row(path, data_set, method):
+    report = json.loads(path.read_text())
+    s = next(x for x in report["sets"] if x["set"] == data_set)
+    return next(x for x in s["methods"] if x["method"] == method)
+
+
+print("Style and content accuracy (judge seed 1) on the shipped fold (last take held out) /")
+print("the other fold (first take held out) / both pooled; |T_out - T_style|, foot skating")
+print("and jitter pooled over both folds.\n")
+print("| set | method | asymmetry | style acc. | content acc. | \\|T_out - T_style\\| (s) | foot skating | jitter |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+for data_set in ["dataset-1", "dataset-2"]:
+    for method in METHODS:
+        for asymmetry, paths in RUNS.items():
+            rows = [method_row(p, data_set, method) for p in paths]
+            pairs = sum(r["pairs"] for r in rows)
+
+            def pooled(key):
+                return sum(r[key] * r["pairs"] for r in rows) / pairs
+
+            def folds(key):
+                cells = [f"{100 * r[key]:.1f}" for r in rows] + [f"{100 * pooled(key):.1f}%"]
+                return " / ".join(cells)
+
+            print(
+                f"| {data_set} | {method} | {asymmetry} | {folds('style_accuracy')} "
+                f"| {folds('content_accuracy')} | {pooled('period_error_to_style'):.3f} "
+                f"| {pooled('foot_skating'):.1f} | {pooled('jitter'):.3f} |"
+            )
