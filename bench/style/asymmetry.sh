@@ -9,17 +9,13 @@
 #
 #   bash bench/style/asymmetry.sh      # writes bench/style/out/asymmetry.md
 source "$(dirname "$0")/setup.sh"
-MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
-if [[ ! -f "$MODEL" ]]; then
-  echo "needs the other fold's model $MODEL: run bash bench/style/run.sh --other-fold first" >&2
-  exit 1
-fi
+require_fold_model
 RUNS=${RUNS_DIR:-/tmp/style-asymmetry}
 mkdir -p "$RUNS"
 COMMON=(--asymmetry style --sources walk,walk-turn-left,walk-turn-right --styles walk
   --classifier-contents "$WALKS")
 "$BIN/style_eval" "${COMMON[@]}" --json "$RUNS/eval-last.json" \
   "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
-"$BIN/style_eval" "${COMMON[@]}" --held-out first --model "$MODEL" \
+"$BIN/style_eval" "${COMMON[@]}" --held-out first --model "$FOLD_MODEL" \
   --json "$RUNS/eval-first.json" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 python3 bench/style/asymmetry_table.py "$RUNS" > "$OUT/asymmetry.md"

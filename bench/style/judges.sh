@@ -12,18 +12,14 @@
 # reports (about 1 MB each) stay in ${RUNS_DIR:-/tmp/style-judges}; the tables
 # go to bench/style/out/judges.md.
 source "$(dirname "$0")/setup.sh"
-MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
-if [[ ! -f "$MODEL" ]]; then
-  echo "needs the other fold's model $MODEL: run bash bench/style/run.sh --other-fold first" >&2
-  exit 1
-fi
+require_fold_model
 RUNS=${RUNS_DIR:-/tmp/style-judges}
 mkdir -p "$RUNS"
 for judge in forest conv-net; do
   for seed in 1 2 3; do
     for fold in last first; do
       FOLD_ARGS=(--held-out "$fold")
-      [[ $fold == first ]] && FOLD_ARGS+=(--model "$MODEL")
+      [[ $fold == first ]] && FOLD_ARGS+=(--model "$FOLD_MODEL")
       "$BIN/classifiers" --held-out "$fold" --seed "$seed" --cv-style \
         --classifier-contents "$WALKS" --style-judge "$judge" "$DATA/dataset-1" \
         > "$RUNS/classifiers-$judge-$fold-seed$seed.json"

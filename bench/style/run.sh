@@ -91,11 +91,10 @@ if flag --other-fold; then
   # recipe on the other takes (same seed), then the same evaluation runs;
   # style.md, "The other fold".
   FOLD=$OUT/fold-first
-  MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
   mkdir -p "$FOLD"
   "$BIN/style_train" --held-out first --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
-    -o "$MODEL" "$DATA/dataset-1" "$DATA/dataset-2" > "$FOLD/train.json"
-  "$BIN/style_eval" --held-out first --model "$MODEL" \
+    -o "$FOLD_MODEL" "$DATA/dataset-1" "$DATA/dataset-2" > "$FOLD/train.json"
+  "$BIN/style_eval" --held-out first --model "$FOLD_MODEL" \
     --sources walk,walk-turn-left,walk-turn-right --styles walk \
     --classifier-contents "$WALKS" --json "$FOLD/eval.json" --markdown "$FOLD/eval.md" \
     "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null

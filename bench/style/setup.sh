@@ -16,3 +16,12 @@ BIN=$CARGO_TARGET_DIR/debug/examples
 WALKS=walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right
 OUT=bench/style/out
 mkdir -p "$OUT"
+# The other fold's model (the first take of each group held out), which
+# `run.sh --other-fold` trains and judges.sh and asymmetry.sh read.
+FOLD_MODEL=${MODEL_DIR:-/tmp}/style-fold-first.safetensors
+require_fold_model() {
+  if [[ ! -f "$FOLD_MODEL" ]]; then
+    echo "needs the other fold's model $FOLD_MODEL: run bash bench/style/run.sh --other-fold first" >&2
+    exit 1
+  fi
+}
