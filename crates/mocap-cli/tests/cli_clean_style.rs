@@ -970,7 +970,7 @@ fn style_apply_reads_an_amc_source_as_its_converted_bvh() {
 }
 
 #[test]
-fn style_eval_names_its_judges_and_can_judge_style_with_the_conv_net() {
+fn style_eval_names_its_judges_and_settings_and_can_judge_style_with_the_conv_net() {
     let Some(data) = mocap_testdata::shared_data() else {
         return;
     };
@@ -1003,6 +1003,11 @@ fn style_eval_names_its_judges_and_can_judge_style_with_the_conv_net() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("style: conv net") && text.contains("content: forest"),
+        "{text}"
+    );
+    // The report says how the outputs were restyled.
+    assert!(
+        text.contains("root feet-along-source, asymmetry source"),
         "{text}"
     );
     // Both real held-out walks are judged right, and so is the style clip

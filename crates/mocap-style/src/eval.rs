@@ -1000,6 +1000,24 @@ impl EvalReport {
                 &o.net
             ),
         );
+        // The settings the outputs were restyled with, so that a report says
+        // which variant it measured.
+        let c = &o.convert;
+        s.push_str(&format!(
+            "Restyled with: patches of {} frames (elastic: +-{:.0}% in steps of {}), root {}, \
+             asymmetry {}{}, strength {}.\n\n",
+            c.patch,
+            100.0 * c.stretch,
+            c.stretch_step,
+            c.root.name(),
+            c.asymmetry.name(),
+            if c.foot_contacts {
+                ", ankles pinned on the ground"
+            } else {
+                ""
+            },
+            c.strength,
+        ));
         for set in &self.sets {
             s.push_str(&format!(
                 "### {}\n\n{} styles (chance {:.1}%), {} contents; classifiers trained on {} clips, \
