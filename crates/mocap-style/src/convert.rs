@@ -35,15 +35,15 @@
 //!    between the mean latent code of the source and that of its mirror
 //!    image. Colouring gives the output the style's mean, which is
 //!    left-right symmetric since the style's statistics cover its clip and
-//!    its mirror; but a turn's lean and sideways footwork, or a sidestep,
-//!    lie partly in the mean (the left leg held differently from the
-//!    right), and with the style's mean and a straight walk's patches a
-//!    turn came out as a straight walk. The half-difference is the part of
-//!    the source's mean that mirroring flips: about zero for a straight walk
-//!    (over whole strides the mirror shows the same poses half a stride
-//!    later), so walks are left as before, and it carries which way and how
-//!    hard the source turns. [`Asymmetry::Style`] leaves it out (the
-//!    report's method).
+//!    its mirror; but a turn places its feet to one side of the pelvis, an
+//!    offset that lies partly in the mean (the left leg held differently
+//!    from the right), and with the style's mean and a straight walk's
+//!    patches a turn came out as a straight walk. The half-difference is the
+//!    part of the source's mean that mirroring flips: about zero for a
+//!    straight walk (over whole strides the mirror shows the same poses half
+//!    a stride later), so walks are left nearly as before, while a turn
+//!    keeps the side its feet are placed to. [`Asymmetry::Style`] leaves it
+//!    out (the report's method).
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
 //! the whitened source frames with the style's statistics without any
@@ -181,7 +181,9 @@ impl std::str::FromStr for RootPath {
 #[serde(rename_all = "kebab-case")]
 pub enum Asymmetry {
     /// The source's: the part of its mean latent code that mirroring flips
-    /// is added to the output, so turns and sidesteps keep their direction.
+    /// is added to the output, so a turn keeps the feet's sideways
+    /// placement (measured on turns; sidesteps, which have no
+    /// held-out takes, were not).
     #[default]
     Source,
     /// The style's (symmetric) mean alone: the report's method.

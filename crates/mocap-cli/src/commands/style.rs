@@ -123,8 +123,8 @@ struct ApplyArgs {
     /// some style, see bench/results/style.md).
     #[arg(long)]
     foot_contacts: bool,
-    /// Whose left-right asymmetry the output keeps: `source` (default: a turn or a sidestep
-    /// keeps its direction and lean) or `style` (the style's symmetric mean alone: the
+    /// Whose left-right asymmetry the output keeps: `source` (default: a turn keeps the feet's
+    /// sideways placement) or `style` (the style's symmetric mean alone: the
     /// report's method, which restyles turns into near-straight walks).
     #[arg(long, value_name = "source|style", default_value = "source")]
     asymmetry: Asymmetry,
