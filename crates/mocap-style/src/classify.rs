@@ -504,12 +504,22 @@ fn fit_nearest_mean(rows: &[f32], dim: usize, labels: &[u32], classes: usize) ->
 }
 
 impl Fitted {
-    /// Adds one window's score for every class to `votes` (the network's
-    /// probabilities, or the row model's scores of its descriptor row).
-    fn add_votes(&self, descriptor: Descriptor, w: &FeatureSequence, fps: f64, votes: &mut [f32]) {
+    /// Adds the windows' scores for every class to `votes` (the network's
+    /// probabilities, or the row model's scores of each descriptor row).
+    fn add_votes(
+        &self,
+        descriptor: Descriptor,
+        windows: &[FeatureSequence],
+        fps: f64,
+        votes: &mut [f32],
+    ) {
         match self {
-            Fitted::ConvNet(net) => net.add_votes(w, votes),
-            Fitted::Rows(model) => model.add_votes(&descriptor_row(descriptor, w, fps), votes),
+            Fitted::ConvNet(net) => net.add_votes(windows, votes),
+            Fitted::Rows(model) => {
+                for w in windows {
+                    model.add_votes(&descriptor_row(descriptor, w, fps), votes);
+                }
+            }
         }
     }
 }
@@ -633,10 +643,9 @@ impl ClipClassifier {
     /// means).
     pub fn predict(&self, motion: &Motion) -> Result<String> {
         let mut votes = vec![0.0f32; self.classes.len()];
-        for w in feature_windows(motion, self.config.windows)? {
-            self.fitted
-                .add_votes(self.config.descriptor, &w, motion.fps(), &mut votes);
-        }
+        let windows = feature_windows(motion, self.config.windows)?;
+        self.fitted
+            .add_votes(self.config.descriptor, &windows, motion.fps(), &mut votes);
         Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
     }
 

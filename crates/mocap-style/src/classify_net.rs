@@ -210,18 +210,26 @@ impl FittedNet {
         })
     }
 
-    /// Adds the class probabilities of one window to `votes`.
-    pub(crate) fn add_votes(&self, window: &FeatureSequence, votes: &mut [f32]) {
-        let frames = window.frame_count();
-        if frames < MIN_FRAMES {
-            return;
+    /// Adds the class probabilities of every window to `votes`. Windows
+    /// of one length go through the network together (a clip's windows
+    /// all have one length but for a clip shorter than a window), which is
+    /// what the evaluation's many predictions spend their time on.
+    pub(crate) fn add_votes(&self, windows: &[FeatureSequence], votes: &mut [f32]) {
+        let mut by_length: std::collections::BTreeMap<usize, Vec<FeatureSequence>> =
+            Default::default();
+        for w in windows.iter().filter(|w| w.frame_count() >= MIN_FRAMES) {
+            let input = standardised(&net_input(w, self.velocities), &self.mean, &self.scale);
+            by_length.entry(w.frame_count()).or_default().push(input);
         }
-        let window = standardised(&net_input(window, self.velocities), &self.mean, &self.scale);
-        let x = input_tensor(std::iter::once(&window), frames, &self.device);
-        let p = softmax(self.net.forward(x), 1).into_data();
-        let p: Vec<f32> = p.try_to_vec().expect("f32 probabilities");
-        for (v, q) in votes.iter_mut().zip(p) {
-            *v += q;
+        for (frames, batch) in by_length {
+            let x = input_tensor(batch.iter(), frames, &self.device);
+            let p = softmax(self.net.forward(x), 1).into_data();
+            let p: Vec<f32> = p.try_to_vec().expect("f32 probabilities");
+            for window_p in p.chunks(votes.len()) {
+                for (v, q) in votes.iter_mut().zip(window_p) {
+                    *v += q;
+                }
+            }
         }
     }
 }
@@ -359,7 +367,7 @@ mod tests {
         for (phase, class) in [(2.0, 0), (5.1, 0), (1.3, 1), (4.4, 1)] {
             let mut votes = [0.0f32; 2];
             let frequency = if class == 0 { 0.2 } else { 0.9 };
-            net.add_votes(&window(frequency, phase), &mut votes);
+            net.add_votes(&[window(frequency, phase)], &mut votes);
             let predicted = usize::from(votes[1] > votes[0]);
             assert_eq!(predicted, class, "phase {phase}: {votes:?}");
             assert!((votes[0] + votes[1] - 1.0).abs() < 1e-4);
