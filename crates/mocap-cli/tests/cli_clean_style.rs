@@ -532,8 +532,17 @@ fn style_apply_restyles_the_bundled_walk() {
     let (style_report, style_motion) = restyle(&["--asymmetry", "style"]);
     assert_eq!(along_report["asymmetry"], "source");
     assert_eq!(style_report["asymmetry"], "style");
+    // Averaged over two of the source's strides (about 1.1 s each), or over
+    // the whole clip with `source-clip`.
+    let window = along_report["asymmetry_window_s"].as_f64().unwrap();
+    assert!((1.6..3.0).contains(&window), "window {window} s");
+    let (clip_report, _) = restyle(&["--asymmetry", "source-clip"]);
+    assert_eq!(clip_report["asymmetry"], "source-clip");
+    assert!(clip_report["asymmetry_window_s"].is_null());
+    assert!(style_report["asymmetry_window_s"].is_null());
     let change = mocap_core::metrics::mean_rotation_error_degrees(&along_motion, &style_motion)
         .expect("same frames and joints");
+    eprintln!("keeping the straight walk's asymmetry moved it by {change} degrees");
     assert!(
         change < ASYMMETRY_CHANGE_MAX_DEG,
         "a straight walk moved by {change} degrees"

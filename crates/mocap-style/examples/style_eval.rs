@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release -p mocap-style --example style_eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
-//!     [--classifier-contents walk,walk-back] [--style-judge forest|conv-net] [--seed S] [--patch 32] [--asymmetry source|style] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
+//!     [--classifier-contents walk,walk-back] [--style-judge forest|conv-net] [--seed S] [--patch 32] [--asymmetry source|source-clip|style] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...
 //! ```
 
@@ -35,7 +35,9 @@ fn main() {
             "--root-from-feet" => options.convert.root = RootPath::Feet,
             "--root" => options.convert.root = value().parse().expect("--root PATH"),
             "--asymmetry" => {
-                options.convert.asymmetry = value().parse().expect("--asymmetry source|style")
+                options.convert.asymmetry = value()
+                    .parse()
+                    .expect("--asymmetry source|source-clip|style")
             }
             "--patch" => options.convert.patch = value().parse().expect("--patch N"),
             "--style-descriptor" => {

@@ -75,6 +75,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             Method::ElasticPatches,
             RootPath::FeetAlongSource,
+            Asymmetry::SourceClip,
+        ),
+        (
+            Method::ElasticPatches,
+            RootPath::FeetAlongSource,
             Asymmetry::Style,
         ),
     ] {

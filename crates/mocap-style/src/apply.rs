@@ -40,9 +40,11 @@ use crate::contact::{
     clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions, RootShift,
 };
 use crate::convert::{
-    convert, Asymmetry, Conversion, ConvertOptions, Latents, Method, RootPath, StyleInput,
+    asymmetry_track, convert, Asymmetry, Conversion, ConvertOptions, Latents, Method, RootPath,
+    StyleInput,
 };
 use crate::data::mirrored;
+use crate::eval::gait_period;
 use crate::features::{compose, decompose, sample_frames, RootTrack};
 use crate::train::StyleModel;
 use crate::{invalid, Result};
@@ -194,6 +196,9 @@ pub struct Restyled {
     /// How far the feet moved the root from the source's path (file units;
     /// zero with [`RootPath::Source`]).
     pub root_shift: RootShift,
+    /// Seconds over which the source's asymmetry was averaged (two of its
+    /// strides); `None`: over the whole clip, or not kept.
+    pub asymmetry_window_s: Option<f64>,
 }
 
 /// Mean angle (degrees) between the local rotations of the model's joints
@@ -262,13 +267,20 @@ pub fn restyle(
         })
         .collect();
     // The mirror image's codes, for the source's asymmetry (convert.rs,
-    // step 6).
-    let mirror_features = match options.asymmetry {
-        Asymmetry::Source => {
-            let (mirror_rotations, _) = decompose(&mirrored(&src)?, rig);
-            Some(model.features(&mirror_rotations))
-        }
-        Asymmetry::Style => None,
+    // step 6), averaged over two of the source's strides.
+    let mirror_features = if options.asymmetry.keeps_the_source() {
+        let (mirror_rotations, _) = decompose(&mirrored(&src)?, rig);
+        Some(model.features(&mirror_rotations))
+    } else {
+        None
+    };
+    // A source without a gait, or shorter than two strides, keeps one
+    // offset for the whole clip.
+    let asymmetry_window_s = match options.asymmetry {
+        Asymmetry::Source => gait_period(&src, rig)
+            .map(|stride| 2.0 * stride)
+            .filter(|&window| ((window * src.fps()).round() as usize) < src.frame_count()),
+        Asymmetry::SourceClip | Asymmetry::Style => None,
     };
     timings.prepare += t.elapsed().as_secs_f64();
 
@@ -278,6 +290,12 @@ pub fn restyle(
     timings.encode += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
+    let asymmetry = mirror_latents
+        .map(|mirror| {
+            let window = asymmetry_window_s.map(|s| (s * src.fps()) as f32);
+            asymmetry_track(&latents, &mirror, window)
+        })
+        .transpose()?;
     let inputs: Vec<StyleInput> = scaled
         .iter()
         .zip(styles)
@@ -288,7 +306,7 @@ pub fn restyle(
         .collect();
     let conversion = convert(
         &latents,
-        mirror_latents.as_ref(),
+        asymmetry.as_ref(),
         &root.heights(),
         &inputs,
         options,
@@ -319,6 +337,7 @@ pub fn restyle(
         conversion,
         timings,
         root_shift,
+        asymmetry_window_s,
     })
 }
 
@@ -361,6 +380,11 @@ pub struct ApplyReport {
     pub root_shift: RootShift,
     pub foot_contacts: bool,
     pub asymmetry: Asymmetry,
+    /// Seconds over which the source's asymmetry was averaged (two of its
+    /// strides, [`Asymmetry::Source`]); `None`: over the whole clip (a
+    /// source without a gait, or [`Asymmetry::SourceClip`]), or not kept.
+    #[serde(default)]
+    pub asymmetry_window_s: Option<f64>,
     pub source_frames: usize,
     pub output_frames: usize,
     pub fps: f64,
@@ -587,6 +611,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         root_shift: restyled.root_shift,
         foot_contacts: options.foot_contacts,
         asymmetry: options.asymmetry,
+        asymmetry_window_s: restyled.asymmetry_window_s,
         source_frames: source.frame_count(),
         output_frames: output.frame_count(),
         fps: output.fps(),

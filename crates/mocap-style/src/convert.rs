@@ -31,19 +31,23 @@
 //!    elastic output lasts about halfway between the source and the full
 //!    style.
 //! 6. Asymmetry (not in the report; [`Asymmetry::Source`], the default):
-//!    the output latent gets `s(t) (m_x - m_x~) / 2`, half the difference
-//!    between the mean latent code of the source and that of its mirror
-//!    image. Colouring gives the output the style's mean, which is
-//!    left-right symmetric since the style's statistics cover its clip and
-//!    its mirror; but a turn places its feet to one side of the pelvis, an
-//!    offset that lies partly in the mean (the left leg held differently
-//!    from the right), and with the style's mean and a straight walk's
-//!    patches a turn came out as a straight walk. The half-difference is the
-//!    part of the source's mean that mirroring flips: about zero for a
-//!    straight walk (over whole strides the mirror shows the same poses half
-//!    a stride later), so walks are left nearly as before, while a turn
-//!    keeps the side its feet are placed to. [`Asymmetry::Style`] leaves it
-//!    out (the report's method).
+//!    the output latent gets `s(t) d(t)`, where `d` is half the difference
+//!    between the latent code of the source and that of its mirror image,
+//!    averaged over two strides around each source frame
+//!    ([`asymmetry_track`]). Colouring gives the output the style's mean,
+//!    which is left-right symmetric since the style's statistics cover its
+//!    clip and its mirror; but a turn places its feet to one side of the
+//!    pelvis, an offset that lies partly in the mean (the left leg held
+//!    differently from the right), and with the style's mean and a straight
+//!    walk's patches a turn came out as a straight walk. The half-difference
+//!    is the part of the source's code that mirroring flips: over whole
+//!    strides about zero for a straight walk (the mirror shows the same
+//!    poses half a stride later), so walks are left nearly as before, while
+//!    a turn keeps the side its feet are placed to. Averaged over two
+//!    strides rather than the whole clip, a take that walks straight and
+//!    then turns keeps each part's own offset; [`Asymmetry::SourceClip`]
+//!    keeps one offset for the whole clip (session 16), and
+//!    [`Asymmetry::Style`] leaves it out (the report's method).
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
 //! the whitened source frames with the style's statistics without any
@@ -175,29 +179,41 @@ impl std::str::FromStr for RootPath {
     }
 }
 
-/// Whose left-right asymmetry the output's mean pose keeps (step 6 of the
-/// module docs).
+/// Whose left-right asymmetry the output keeps (step 6 of the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Asymmetry {
-    /// The source's: the part of its mean latent code that mirroring flips
-    /// is added to the output, so a turn keeps the feet's sideways
-    /// placement (measured on turns; sidesteps, which have no
-    /// held-out takes, were not).
+    /// The source's, along time: the part of its latent code that
+    /// mirroring flips, averaged over two strides around each frame, is
+    /// added to the output, so a turn keeps the feet's sideways placement
+    /// where it turns and a straight stretch of the same take stays
+    /// straight. Clips without a gait, or shorter than two strides, get one
+    /// offset for the whole clip ([`Asymmetry::SourceClip`]).
     #[default]
     Source,
+    /// The source's, one offset for the whole clip (session 16): the
+    /// half-difference of the mean latent codes of the source and its
+    /// mirror.
+    SourceClip,
     /// The style's (symmetric) mean alone: the report's method.
     Style,
 }
 
 impl Asymmetry {
-    pub const ALL: [Asymmetry; 2] = [Asymmetry::Source, Asymmetry::Style];
+    pub const ALL: [Asymmetry; 3] = [Asymmetry::Source, Asymmetry::SourceClip, Asymmetry::Style];
 
     pub fn name(self) -> &'static str {
         match self {
             Asymmetry::Source => "source",
+            Asymmetry::SourceClip => "source-clip",
             Asymmetry::Style => "style",
         }
+    }
+
+    /// Whether the output keeps the source's asymmetry (and so needs the
+    /// codes of the source's mirror).
+    pub fn keeps_the_source(self) -> bool {
+        !matches!(self, Asymmetry::Style)
     }
 }
 
@@ -208,7 +224,9 @@ impl std::str::FromStr for Asymmetry {
         Asymmetry::ALL
             .into_iter()
             .find(|a| a.name() == s)
-            .ok_or_else(|| format!("unknown asymmetry `{s}` (expected source or style)"))
+            .ok_or_else(|| {
+                format!("unknown asymmetry `{s}` (expected source, source-clip or style)")
+            })
     }
 }
 
@@ -461,12 +479,12 @@ struct PreparedStyle<'a> {
 
 /// Converts `source` (latent codes and root height per frame) to the
 /// styles. Weights of the styles are normalised to sum to one.
-/// `source_mirror` holds the latent codes of the source's mirror image,
-/// frame by frame; [`Asymmetry::Source`] needs it, [`Asymmetry::Style`]
-/// ignores it.
+/// `source_asymmetry` is the offset of step 6 per source frame, from
+/// [`asymmetry_track`]; [`Asymmetry::Source`] and
+/// [`Asymmetry::SourceClip`] need it, [`Asymmetry::Style`] ignores it.
 pub fn convert(
     source: &Latents,
-    source_mirror: Option<&Latents>,
+    source_asymmetry: Option<&Latents>,
     source_height: &[f32],
     styles: &[StyleInput],
     options: &ConvertOptions,
@@ -525,22 +543,20 @@ pub fn convert(
             bank,
         });
     }
-    let asymmetry = match (options.asymmetry, source_mirror) {
-        (Asymmetry::Style, _) => vec![0.0; dim],
-        (Asymmetry::Source, Some(mirror)) => {
-            if mirror.dim != dim || mirror.frames != source.frames {
+    let asymmetry = match (options.asymmetry.keeps_the_source(), source_asymmetry) {
+        (false, _) => None,
+        (true, Some(track)) => {
+            if track.dim != dim || track.frames != source.frames {
                 return Err(invalid(format!(
-                    "internal: the source's mirror has {} frames of {} values, the source {} of {}",
-                    mirror.frames, mirror.dim, source.frames, dim
+                    "internal: the source's asymmetry has {} frames of {} values, the source {} of {}",
+                    track.frames, track.dim, source.frames, dim
                 )));
             }
-            mirror_antisymmetric_mean(source, mirror)
+            Some(track)
         }
-        (Asymmetry::Source, None) => {
-            return Err(invalid(
-                "internal: keeping the source's asymmetry needs the latent codes of its mirror",
-            ))
-        }
+        (true, None) => return Err(invalid(
+            "internal: keeping the source's asymmetry needs its track (from the source's mirror)",
+        )),
     };
     let source_stats = Statistics::of_rows([source.data.as_slice()], dim);
     let source_white = source.whitened(&source_stats);
@@ -611,6 +627,7 @@ pub fn convert(
     let mut strength = vec![0.0; frames];
     let mut output_time = vec![0.0; frames];
     let mut x = vec![0.0; dim];
+    let mut kept = vec![0.0; dim];
     let mut o = 0;
     for q in 0..frames {
         // The styled frames `o`, `o + 1` around output frame `q`, and where
@@ -635,9 +652,12 @@ pub fn convert(
         output_time[q] = u;
         strength[q] = s;
         source.sample(u, &mut x);
+        if let Some(track) = asymmetry {
+            track.sample(u, &mut kept);
+        }
         for c in 0..dim {
             let y = (1.0 - a) * converted[o * dim + c] + a * converted[next * dim + c];
-            data[q * dim + c] = (1.0 - s) * x[c] + s * (y + asymmetry[c]);
+            data[q * dim + c] = (1.0 - s) * x[c] + s * (y + kept[c]);
         }
         let y_height = (1.0 - a) * converted_height[o] + a * converted_height[next];
         height[q] = (1.0 - s) * sample_track(source_height, u) + s * y_height;
@@ -659,21 +679,82 @@ pub fn convert(
     })
 }
 
-/// Step 6: `(m_x - m_x~) / 2`, the part of the source's mean latent code
-/// that mirroring flips.
-fn mirror_antisymmetric_mean(source: &Latents, mirror: &Latents) -> Vec<f32> {
-    let mut half_difference = vec![0.0f64; source.dim];
-    for (x, m) in source
+/// Step 6: the offset the output keeps from the source, per source frame.
+///
+/// Per frame, `d(t) = (x(t) - x~(t)) / 2` is the part of the source's code
+/// that mirroring flips (`x~` the code of the source's mirror image, frame
+/// by frame). Within a straight walk the mirror shows the same pose half a
+/// stride later, so `d` swings with the stride about a mean near zero; a
+/// turn shifts that mean to one side. The track is `d` averaged:
+///
+/// - `window_frames = None`, or a clip no longer than the window: over the
+///   whole clip, `(m_x - m_x~) / 2` ([`Asymmetry::SourceClip`]);
+/// - `Some(L)`: a Hann window of `L` frames around each frame. With `L` two
+///   strides long, the window's spectrum is zero at the stride frequency
+///   and at every harmonic of it, so the swing within a stride cancels
+///   while a change from walking straight to turning shows within about a
+///   stride. Near the ends of the clip the window keeps its whole length
+///   inside the clip (the first and last half-windows hold its value), so
+///   the cancellation holds there too.
+pub fn asymmetry_track(
+    source: &Latents,
+    mirror: &Latents,
+    window_frames: Option<f32>,
+) -> Result<Latents> {
+    if mirror.dim != source.dim || mirror.frames != source.frames {
+        return Err(invalid(format!(
+            "internal: the source's mirror has {} frames of {} values, the source {} of {}",
+            mirror.frames, mirror.dim, source.frames, source.dim
+        )));
+    }
+    let (frames, dim) = (source.frames, source.dim);
+    let half_difference: Vec<f64> = source
         .data
-        .chunks_exact(source.dim)
-        .zip(mirror.data.chunks_exact(source.dim))
-    {
-        for c in 0..source.dim {
-            half_difference[c] += 0.5 * (x[c] as f64 - m[c] as f64);
+        .iter()
+        .zip(&mirror.data)
+        .map(|(&x, &m)| 0.5 * (x as f64 - m as f64))
+        .collect();
+    let window = window_frames
+        .map(|l| l.round().max(1.0) as usize)
+        .filter(|&l| l < frames);
+    let mut data = Vec::with_capacity(frames * dim);
+    match window {
+        None => {
+            let mut mean = vec![0.0f64; dim];
+            for row in half_difference.chunks_exact(dim) {
+                mean.iter_mut().zip(row).for_each(|(m, d)| *m += d);
+            }
+            let n = frames.max(1) as f64;
+            let mean: Vec<f32> = mean.iter().map(|m| (m / n) as f32).collect();
+            for _ in 0..frames {
+                data.extend_from_slice(&mean);
+            }
+        }
+        Some(l) => {
+            // Hann weights over `l` frames (their spectrum vanishes at every
+            // multiple of 2/l cycles per frame).
+            let weights: Vec<f64> = (0..l)
+                .map(|k| {
+                    let phase = std::f64::consts::TAU * (k as f64 + 0.5) / l as f64;
+                    0.5 - 0.5 * phase.cos()
+                })
+                .collect();
+            let total: f64 = weights.iter().sum();
+            let mut mean = vec![0.0f64; dim];
+            for f in 0..frames {
+                let start = (f as f64 - l as f64 / 2.0)
+                    .round()
+                    .clamp(0.0, (frames - l) as f64) as usize;
+                mean.iter_mut().for_each(|m| *m = 0.0);
+                for (k, w) in weights.iter().enumerate() {
+                    let row = &half_difference[(start + k) * dim..(start + k + 1) * dim];
+                    mean.iter_mut().zip(row).for_each(|(m, d)| *m += w * d);
+                }
+                data.extend(mean.iter().map(|m| (m / total) as f32));
+            }
         }
     }
-    let n = source.frames.max(1) as f64;
-    half_difference.iter().map(|d| (d / n) as f32).collect()
+    Latents::new(frames, dim, data)
 }
 
 fn mean_height(sequences: &[(Latents, Vec<f32>)]) -> f32 {
@@ -828,8 +909,11 @@ fn swap_patches(source: &Latents, styles: &[PreparedStyle], options: &ConvertOpt
 mod tests {
     use super::*;
 
-    // The sources of these tests are passed as their own mirror images: no
-    // asymmetry to keep (step 6), unless a test says otherwise.
+    /// The sources of these tests have no asymmetry to keep (step 6),
+    /// unless a test says otherwise: they are their own mirror images.
+    fn no_asymmetry(x: &Latents) -> Latents {
+        asymmetry_track(x, x, None).unwrap()
+    }
 
     /// A latent sequence of a gait-like signal with period `period` frames.
     fn periodic(frames: usize, period: f32, phase: f32) -> Latents {
@@ -893,7 +977,7 @@ mod tests {
         };
         let c = convert(
             &x,
-            Some(&x),
+            Some(&no_asymmetry(&x)),
             &h,
             &[StyleInput {
                 sequences: &seqs,
@@ -922,7 +1006,14 @@ mod tests {
             sequences: &y,
             weight: 1.0,
         }];
-        let elastic = convert(&x, Some(&x), &h, &style, &ConvertOptions::default()).unwrap();
+        let elastic = convert(
+            &x,
+            Some(&no_asymmetry(&x)),
+            &h,
+            &style,
+            &ConvertOptions::default(),
+        )
+        .unwrap();
         let ratio = elastic.latents.frames as f32 / 300.0;
         assert!(
             (ratio - 38.0 / 30.0).abs() < 0.1,
@@ -933,7 +1024,7 @@ mod tests {
         assert!(*elastic.source_time.last().unwrap() > 290.0);
         let fixed = convert(
             &x,
-            Some(&x),
+            Some(&no_asymmetry(&x)),
             &h,
             &style,
             &ConvertOptions {
@@ -955,7 +1046,7 @@ mod tests {
         let at = |strength: f32| {
             convert(
                 &x,
-                Some(&x),
+                Some(&no_asymmetry(&x)),
                 &h,
                 &style,
                 &ConvertOptions {
@@ -1006,14 +1097,14 @@ mod tests {
             strength: 0.0,
             ..ConvertOptions::default()
         };
-        let c = convert(&x, Some(&x), &h, &style, &options).unwrap();
+        let c = convert(&x, Some(&no_asymmetry(&x)), &h, &style, &options).unwrap();
         assert_eq!(c.latents.data, x.data);
         let fade = ConvertOptions {
             strength: 0.8,
             fade_in_frames: 60.0,
             ..options
         };
-        let c = convert(&x, Some(&x), &h, &style, &fade).unwrap();
+        let c = convert(&x, Some(&no_asymmetry(&x)), &h, &style, &fade).unwrap();
         assert_eq!(c.strength[0], 0.0);
         assert!((c.strength[30] - 0.4).abs() < 1e-5);
         assert!((c.strength[100] - 0.8).abs() < 1e-5);
@@ -1035,7 +1126,7 @@ mod tests {
             };
             let c = convert(
                 &x,
-                Some(&x),
+                Some(&no_asymmetry(&x)),
                 &h,
                 &[StyleInput {
                     sequences: &ys,
@@ -1086,20 +1177,85 @@ mod tests {
                 asymmetry: Asymmetry::Style,
                 ..kept
             };
-            let a = convert(&x, Some(&mirror), &h, &style, &kept).unwrap();
             let b = convert(&x, None, &h, &style, &symmetric).unwrap();
-            assert_eq!(a.latents.frames, b.latents.frames, "{method:?}");
-            for (i, (u, v)) in a.latents.data.iter().zip(&b.latents.data).enumerate() {
-                let want = 0.6 * d[i % 6];
-                assert!(
-                    (u - v - want).abs() < 1e-4,
-                    "{method:?}: {} != {want}",
-                    u - v
-                );
+            // Over the whole clip, and over two strides around each frame:
+            // the window of two strides cancels the swing within a stride.
+            for window in [None, Some(60.0)] {
+                let track = asymmetry_track(&x, &mirror, window).unwrap();
+                let a = convert(&x, Some(&track), &h, &style, &kept).unwrap();
+                assert_eq!(a.latents.frames, b.latents.frames, "{method:?}");
+                for (i, (u, v)) in a.latents.data.iter().zip(&b.latents.data).enumerate() {
+                    let want = 0.6 * d[i % 6];
+                    assert!(
+                        (u - v - want).abs() < 1e-4,
+                        "{method:?} {window:?}: {} != {want}",
+                        u - v
+                    );
+                }
             }
             let err = convert(&x, None, &h, &style, &kept).unwrap_err();
             assert!(err.to_string().contains("mirror"), "{err}");
         }
+    }
+
+    /// Step 6 along time: a take that walks straight for 150 frames (five
+    /// strides) and then holds off-centre by `d`. Averaged over two strides,
+    /// the offset kept is exactly 0 wherever the window lies in the straight
+    /// part and exactly `d` wherever it lies in the offset part, rising in
+    /// between; over the whole clip it is `d / 2` everywhere. A window of
+    /// one and a half strides lets the swing within a stride through.
+    #[test]
+    fn the_asymmetry_follows_the_take() {
+        let d = [0.3f32, -0.2, 0.0, 0.1, 0.0, 0.05];
+        let offset_after_150 = |l: Latents, sign: f32| {
+            let dim = l.dim;
+            let data = (l.data.iter().enumerate())
+                .map(|(i, v)| {
+                    if i / dim >= 150 {
+                        v + sign * d[i % dim]
+                    } else {
+                        *v
+                    }
+                })
+                .collect();
+            Latents::new(l.frames, dim, data).unwrap()
+        };
+        let x = offset_after_150(periodic(300, 30.0, 0.0), 1.0);
+        let mirror = offset_after_150(periodic(300, 30.0, std::f32::consts::PI), -1.0);
+        let track = asymmetry_track(&x, &mirror, Some(60.0)).unwrap();
+        for f in 0..300 {
+            for (&got, &dc) in track.frame(f).iter().zip(&d) {
+                let want = match f {
+                    0..=90 => Some(0.0),
+                    210.. => Some(dc),
+                    _ => None,
+                };
+                match want {
+                    Some(want) => assert!((got - want).abs() < 1e-5, "frame {f}: {got} != {want}"),
+                    // Between the two: on the way from 0 to d.
+                    None => assert!(got.abs() <= dc.abs() + 1e-5 && got * dc >= -1e-6),
+                }
+            }
+        }
+        let whole = asymmetry_track(&x, &mirror, None).unwrap();
+        for f in 0..300 {
+            for (&got, &dc) in whole.frame(f).iter().zip(&d) {
+                assert!((got - dc / 2.0).abs() < 1e-5);
+            }
+        }
+        let short = asymmetry_track(&x, &mirror, Some(45.0)).unwrap();
+        let swing = (0..=90)
+            .map(|f| short.frame(f)[0].abs())
+            .fold(0.0, f32::max);
+        assert!(
+            swing > 0.01,
+            "a window of 1.5 strides left a swing of {swing}"
+        );
+        // A window as long as the clip is the whole clip.
+        assert_eq!(
+            asymmetry_track(&x, &mirror, Some(300.0)).unwrap().data,
+            whole.data
+        );
     }
 
     #[test]
@@ -1108,7 +1264,7 @@ mod tests {
         let y = style_of(periodic(20, 30.0, 0.0));
         let err = convert(
             &x,
-            Some(&x),
+            Some(&no_asymmetry(&x)),
             &vec![90.0; 100],
             &[StyleInput {
                 sequences: &y,

@@ -366,6 +366,22 @@ pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
     }
 }
 
+/// The mean over frames of the two ankles' sideways offsets from the pelvis
+/// in the body frame (body heights; mocap-search's pose values
+/// `left_ankle.x` and `right_ankle.x`). About zero in a straight walk, well
+/// off it in a turn (its feet land to one side): how turn_cues.sh and the
+/// tests tell whether a restyled turn kept its footwork.
+pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
+    let index = |name: &str| {
+        mocap_search::features::VALUE_NAMES
+            .iter()
+            .position(|n| *n == name)
+            .expect("a pose value of mocap-search")
+    };
+    let statistics = crate::classify::clip_pose_statistics(motion)?;
+    Ok((statistics[index("left_ankle.x")] + statistics[index("right_ankle.x")]) as f64)
+}
+
 /// Mean jerk of all joints (see [`mocap_core::metrics::jitter`]).
 fn motion_jitter(motion: &Motion) -> f64 {
     jitter(&forward_kinematics(motion), None).map_or(f64::NAN, |v| v as f64)

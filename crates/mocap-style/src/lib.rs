@@ -24,8 +24,9 @@
 //!    of patches offset by half a patch is blended in linearly so there are
 //!    no seams. Strength, fade-in and a blend of two styles are latent
 //!    interpolations. Beyond the report, the output keeps the part of the
-//!    source's mean latent code that mirroring flips, so a turn stays a
-//!    turn ([`convert::Asymmetry`]).
+//!    source's latent code that mirroring flips, averaged over two strides
+//!    around each frame, so a turn stays a turn and a take that walks
+//!    straight and then turns keeps both ([`convert::Asymmetry`]).
 //!    [`contact`] can pin the feet during ground contacts afterwards
 //!    (opt-in).
 //! 4. [`apply`]: the whole thing on files (`mocap style apply`); [`eval`]

@@ -10,7 +10,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, prepare_style, restyle, ApplyOptions, StageTimings};
 use mocap_style::convert::{ConvertOptions, Method};
-use mocap_style::eval::{foot_skating, gait_period};
+use mocap_style::eval::{feet_sideways_offset, foot_skating, gait_period};
 use mocap_style::features::RigLayout;
 use mocap_style::train::StyleModel;
 
@@ -310,27 +310,21 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
 /// Keeping the source's left-right asymmetry (the default) brings the
 /// output's mean sideways foot offset back towards the source's. Six
 /// held-out right turns of six styles, restyled with a held-out straight
-/// walk.
+/// walk: 0.0052 body heights from the source's on average (0.0068 with one
+/// offset per clip, session 16), 0.0542 without; the test asserts at most a
+/// quarter.
 #[test]
 fn restyled_turns_keep_their_sideways_footwork() {
-    use mocap_search::features::VALUE_NAMES;
-    use mocap_style::classify::clip_pose_statistics;
     use mocap_style::convert::Asymmetry;
 
-    let index = |name: &str| VALUE_NAMES.iter().position(|n| *n == name).unwrap();
-    let (left, right) = (index("left_ankle.x"), index("right_ankle.x"));
-    // Mean over frames of the two ankles' sideways offsets from the pelvis.
-    let feet_offset = |motion: &mocap_core::Motion| {
-        let statistics = clip_pose_statistics(motion).unwrap();
-        statistics[left] + statistics[right]
-    };
+    let feet_offset = |motion: &mocap_core::Motion| feet_sideways_offset(motion).unwrap();
     let Some(sty) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
         return;
     };
     let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
     let mut t = StageTimings::default();
     let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
-    let mut errors = [0.0f32; 2];
+    let mut errors = [0.0f64; 2];
     for take in [
         "active_040",
         "elderly_028",
@@ -366,6 +360,89 @@ fn restyled_turns_keep_their_sideways_footwork() {
     assert!(
         errors[0] < 0.25 * errors[1],
         "feet offset error {} with the source's asymmetry, {} without",
+        errors[0],
+        errors[1]
+    );
+}
+
+/// A take that walks straight and then turns keeps each part's footwork:
+/// the source's asymmetry is averaged over two strides around each frame
+/// (the default), not over the whole take, where the turn's offset was
+/// spread over the straight part and halved in the turn (`source-clip`,
+/// session 16). Three held-out straight walks each joined to a held-out
+/// right turn of the same style, restyled with a held-out walk of another
+/// style; the output is cut where the source's walk ends. Mean over the
+/// parts of |output - source| of the feet's sideways offset: 0.0038 body
+/// heights against 0.0177 (over the 14 joined takes of the `asymmetry_along`
+/// example, 0.0078 / 0.0090 for the first / second clip against 0.0263 /
+/// 0.0159); the test asserts at most 0.6 of the whole-take offset's error.
+#[test]
+fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
+    use mocap_core::ops::trim;
+    use mocap_style::convert::Asymmetry;
+
+    let Some(sty) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
+        return;
+    };
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let mut t = StageTimings::default();
+    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
+    let mut errors = [0.0f64; 2];
+    for (walk, turn) in [
+        ("elderly_016", "elderly_028"),
+        ("normal_022", "normal_034"),
+        ("youthful_025", "youthful_028"),
+    ] {
+        let (Some(walk_path), Some(turn_path)) = (
+            bandai("dataset-2", &format!("dataset-2_walk_{walk}.bvh")),
+            bandai(
+                "dataset-2",
+                &format!("dataset-2_walk-turn-right_{turn}.bvh"),
+            ),
+        ) else {
+            return;
+        };
+        let mut source = read_bvh(&walk_path).unwrap();
+        let split = source.frame_count();
+        source.append(&read_bvh(&turn_path).unwrap()).unwrap();
+        let parts = |m: &mocap_core::Motion, cut: usize| {
+            [0..cut, cut..m.frame_count()]
+                .map(|r| feet_sideways_offset(&trim(m, r).unwrap()).unwrap())
+        };
+        let wanted = parts(&source, split);
+        for (k, asymmetry) in [Asymmetry::Source, Asymmetry::SourceClip]
+            .into_iter()
+            .enumerate()
+        {
+            let options = ConvertOptions {
+                asymmetry,
+                ..ConvertOptions::default()
+            };
+            let out = restyle(&model, &source, &[(&clip, 1.0)], &options, t).unwrap();
+            if asymmetry == Asymmetry::Source {
+                let window = out.asymmetry_window_s.expect("a gait");
+                assert!((1.5..3.0).contains(&window), "two strides: {window} s");
+            }
+            let cut = (out.conversion.source_time.iter())
+                .position(|&u| u >= split as f32)
+                .unwrap();
+            let got = parts(&out.motion, cut);
+            for part in 0..2 {
+                eprintln!(
+                    "{walk} + {turn} {asymmetry:?}, part {part}: feet offset {:.4}, source {:.4}",
+                    got[part], wanted[part]
+                );
+                errors[k] += (got[part] - wanted[part]).abs() / 6.0;
+            }
+        }
+    }
+    eprintln!(
+        "mean |output - source|: along the take {:.4}, one offset per take {:.4}",
+        errors[0], errors[1]
+    );
+    assert!(
+        errors[0] < 0.6 * errors[1],
+        "feet offset error {} along the take, {} with one offset per take",
         errors[0],
         errors[1]
     );

@@ -123,10 +123,16 @@ struct ApplyArgs {
     /// some style, see bench/results/style.md).
     #[arg(long)]
     foot_contacts: bool,
-    /// Whose left-right asymmetry the output keeps: `source` (default: a turn keeps the feet's
-    /// sideways placement) or `style` (the style's symmetric mean alone: the
-    /// report's method, which restyles turns into near-straight walks).
-    #[arg(long, value_name = "source|style", default_value = "source")]
+    /// Whose left-right asymmetry the output keeps: `source` (default: the source's, averaged
+    /// over two of its strides around each frame, so a turn keeps the feet's sideways placement
+    /// where it turns), `source-clip` (the source's, one offset for the whole clip) or `style`
+    /// (the style's symmetric mean alone: the report's method, which restyles turns into
+    /// near-straight walks).
+    #[arg(
+        long,
+        value_name = "source|source-clip|style",
+        default_value = "source"
+    )]
     asymmetry: Asymmetry,
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
@@ -171,7 +177,11 @@ struct EvalArgs {
     #[arg(long)]
     foot_contacts: bool,
     /// Whose left-right asymmetry the outputs keep, as `apply --asymmetry`.
-    #[arg(long, value_name = "source|style", default_value = "source")]
+    #[arg(
+        long,
+        value_name = "source|source-clip|style",
+        default_value = "source"
+    )]
     asymmetry: Asymmetry,
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
