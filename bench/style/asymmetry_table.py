@@ -1,9 +1,10 @@
-"""Before/after table of bench/style/asymmetry.sh: every method on both folds,
-with the source's left-right asymmetry kept (the default, eval.json) and
-without it (`--asymmetry style`, the report's method).
+"""Table of bench/style/asymmetry.sh: every method on both folds, with the
+source's left-right asymmetry kept along the take (the default, eval.json),
+kept as one offset per clip (`--asymmetry source-clip`) and not kept
+(`--asymmetry style`, the report's method).
 
 Usage: python3 bench/style/asymmetry_table.py RUNS_DIR > bench/style/out/asymmetry.md
-RUNS_DIR holds eval-last.json and eval-first.json of `--asymmetry style`.
+RUNS_DIR holds eval-{style,source-clip}-{last,first}.json.
 """
 import json
 import pathlib
@@ -12,7 +13,11 @@ import sys
 OUT = pathlib.Path(__file__).resolve().parent / "out"
 RUNS_DIR = pathlib.Path(sys.argv[1])
 RUNS = {
-    "style (report)": (RUNS_DIR / "eval-last.json", RUNS_DIR / "eval-first.json"),
+    "style (report)": (RUNS_DIR / "eval-style-last.json", RUNS_DIR / "eval-style-first.json"),
+    "source-clip (session 16)": (
+        RUNS_DIR / "eval-source-clip-last.json",
+        RUNS_DIR / "eval-source-clip-first.json",
+    ),
     "source (default)": (OUT / "eval.json", OUT / "fold-first/eval.json"),
 }
 METHODS = ["elastic-patches", "fixed-patches", "whitening-colouring", "adain"]
