@@ -32,7 +32,9 @@ use std::path::PathBuf;
 use mocap_core::ops::trim;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
+use mocap_style::apply::{
+    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings,
+};
 use mocap_style::convert::{Asymmetry, ConvertOptions};
 use mocap_style::data::{
     held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake,
@@ -146,18 +148,21 @@ fn main() {
             source_tally.content_right[k] += right as usize;
         }
         source_tally.outputs += 1;
+        let prepared_source = settings.map(|a| prepare_source(&model, &source.motion, a).unwrap());
         for (clip, style) in style_walks.iter().zip(&prepared) {
             if clip.labels.style == source.parts[0].labels.style {
                 continue;
             }
-            for (tally, &asymmetry) in tallies.iter_mut().zip(&settings) {
+            for ((tally, &asymmetry), prepared) in
+                tallies.iter_mut().zip(&settings).zip(&prepared_source)
+            {
                 let options = ConvertOptions {
                     asymmetry,
                     ..ConvertOptions::default()
                 };
                 let t = StageTimings::default();
-                let out =
-                    restyle(&model, &source.motion, &[(style, 1.0)], &options, t).expect("restyle");
+                let out = restyle_prepared(&model, prepared, &[(style, 1.0)], &options, t)
+                    .expect("restyle");
                 if asymmetry == Asymmetry::Source {
                     windows.push(out.asymmetry_window_s);
                 }

@@ -148,6 +148,20 @@ impl StageTimings {
     }
 }
 
+impl std::ops::Add for StageTimings {
+    type Output = StageTimings;
+
+    fn add(self, other: StageTimings) -> StageTimings {
+        StageTimings {
+            prepare: self.prepare + other.prepare,
+            encode: self.encode + other.encode,
+            matching: self.matching + other.matching,
+            decode: self.decode + other.decode,
+            compose: self.compose + other.compose,
+        }
+    }
+}
+
 /// A style clip ready to convert to: latent codes and root heights of the
 /// clip and its mirror.
 #[derive(Debug, Clone)]
@@ -236,6 +250,86 @@ pub const UNFAMILIAR_SOURCE_DEG: f32 = 7.0;
 /// [`ApplyReport::model`] when the shipped model restyled.
 pub const BUILT_IN_MODEL: &str = "built-in default";
 
+/// A source ready to restyle: resampled to the model's rate, its root, its
+/// latent codes and, when the source's asymmetry is kept, the offset to keep
+/// per frame (convert.rs, step 6). The evaluation prepares each source once
+/// for all its style clips and methods.
+#[derive(Debug, Clone)]
+pub struct PreparedSource {
+    /// The source at the model's frame rate.
+    motion: Motion,
+    /// The frame rate of the source as given (the output's).
+    fps: f64,
+    root: RootTrack,
+    leg_length: f32,
+    latents: Latents,
+    /// The setting the source was prepared for.
+    asymmetry: Asymmetry,
+    /// The offset of step 6 per source frame (`None` with
+    /// [`Asymmetry::Style`]).
+    asymmetry_track: Option<Latents>,
+    asymmetry_window_s: Option<f64>,
+    /// Preparing and encoding the source (and its mirror).
+    pub timings: StageTimings,
+}
+
+/// Prepares `source` (any frame rate) for [`restyle_prepared`] with the
+/// asymmetry setting `asymmetry`.
+pub fn prepare_source(
+    model: &StyleModel,
+    source: &Motion,
+    asymmetry: Asymmetry,
+) -> Result<PreparedSource> {
+    let mut timings = StageTimings::default();
+    let rig = &model.description.rig;
+    let t = Instant::now();
+    let src = model.prepare(source, "source")?;
+    let (rotations, root) = decompose(&src, rig);
+    let features = model.features(&rotations);
+    // The mirror image's codes, for the source's asymmetry (convert.rs,
+    // step 6), averaged over two of the source's strides.
+    let mirror_features = if asymmetry.keeps_the_source() {
+        let (mirror_rotations, _) = decompose(&mirrored(&src)?, rig);
+        Some(model.features(&mirror_rotations))
+    } else {
+        None
+    };
+    // A source without a gait, or shorter than two strides, keeps one
+    // offset for the whole clip.
+    let asymmetry_window_s = match asymmetry {
+        Asymmetry::Source => gait_period(&src, rig)
+            .map(|stride| 2.0 * stride)
+            .filter(|&window| ((window * src.fps()).round() as usize) < src.frame_count()),
+        Asymmetry::SourceClip | Asymmetry::Style => None,
+    };
+    timings.prepare += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let latents = model.encode(&features)?;
+    let mirror_latents = mirror_features.map(|f| model.encode(&f)).transpose()?;
+    timings.encode += t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let asymmetry_track = mirror_latents
+        .map(|mirror| {
+            let window = asymmetry_window_s.map(|s| (s * src.fps()) as f32);
+            asymmetry_track(&latents, &mirror, window)
+        })
+        .transpose()?;
+    timings.matching += t.elapsed().as_secs_f64();
+    Ok(PreparedSource {
+        leg_length: rig.leg_length(src.skeleton()),
+        motion: src,
+        fps: source.fps(),
+        root,
+        latents,
+        asymmetry,
+        asymmetry_track,
+        asymmetry_window_s,
+        timings,
+    })
+}
+
 /// Restyles `source` (any frame rate; output at the same rate) to the
 /// weighted styles.
 pub fn restyle(
@@ -243,14 +337,33 @@ pub fn restyle(
     source: &Motion,
     styles: &[(&StyleClip, f32)],
     options: &ConvertOptions,
+    timings: StageTimings,
+) -> Result<Restyled> {
+    let prepared = prepare_source(model, source, options.asymmetry)?;
+    restyle_prepared(model, &prepared, styles, options, timings)
+}
+
+/// [`restyle`] of a source prepared by [`prepare_source`] with the same
+/// asymmetry setting as `options`. `timings` (the style clips' preparing,
+/// say) are added to the source's and this restyle's.
+pub fn restyle_prepared(
+    model: &StyleModel,
+    source: &PreparedSource,
+    styles: &[(&StyleClip, f32)],
+    options: &ConvertOptions,
     mut timings: StageTimings,
 ) -> Result<Restyled> {
+    if source.asymmetry != options.asymmetry {
+        return Err(invalid(format!(
+            "internal: the source was prepared for asymmetry {}, the restyle asks for {}",
+            source.asymmetry.name(),
+            options.asymmetry.name()
+        )));
+    }
+    timings = timings + source.timings;
     let rig = &model.description.rig;
     let t = Instant::now();
-    let src = model.prepare(source, "source")?;
-    let (rotations, root) = decompose(&src, rig);
-    let features = model.features(&rotations);
-    let leg = rig.leg_length(src.skeleton());
+    let leg = source.leg_length;
     // Style heights scaled to the source performer.
     let scaled: Vec<Vec<(Latents, Vec<f32>)>> = styles
         .iter()
@@ -266,36 +379,9 @@ pub fn restyle(
                 .collect()
         })
         .collect();
-    // The mirror image's codes, for the source's asymmetry (convert.rs,
-    // step 6), averaged over two of the source's strides.
-    let mirror_features = if options.asymmetry.keeps_the_source() {
-        let (mirror_rotations, _) = decompose(&mirrored(&src)?, rig);
-        Some(model.features(&mirror_rotations))
-    } else {
-        None
-    };
-    // A source without a gait, or shorter than two strides, keeps one
-    // offset for the whole clip.
-    let asymmetry_window_s = match options.asymmetry {
-        Asymmetry::Source => gait_period(&src, rig)
-            .map(|stride| 2.0 * stride)
-            .filter(|&window| ((window * src.fps()).round() as usize) < src.frame_count()),
-        Asymmetry::SourceClip | Asymmetry::Style => None,
-    };
     timings.prepare += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let latents = model.encode(&features)?;
-    let mirror_latents = mirror_features.map(|f| model.encode(&f)).transpose()?;
-    timings.encode += t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let asymmetry = mirror_latents
-        .map(|mirror| {
-            let window = asymmetry_window_s.map(|s| (s * src.fps()) as f32);
-            asymmetry_track(&latents, &mirror, window)
-        })
-        .transpose()?;
     let inputs: Vec<StyleInput> = scaled
         .iter()
         .zip(styles)
@@ -305,9 +391,9 @@ pub fn restyle(
         })
         .collect();
     let conversion = convert(
-        &latents,
-        asymmetry.as_ref(),
-        &root.heights(),
+        &source.latents,
+        source.asymmetry_track.as_ref(),
+        &source.root.heights(),
         &inputs,
         options,
     )?;
@@ -319,15 +405,21 @@ pub fn restyle(
 
     let t = Instant::now();
     let out_rotations = model.description.normalization.rotations(&decoded);
-    let mut motion = rebuild(&src, &root, &conversion, &out_rotations, rig)?;
+    let mut motion = rebuild(
+        &source.motion,
+        &source.root,
+        &conversion,
+        &out_rotations,
+        rig,
+    )?;
     let root_shift = RootFromFeetOptions::for_path(options.root)
         .map(|feet| root_from_feet(&mut motion, rig, &feet))
         .unwrap_or_default();
     if options.foot_contacts {
         clean_foot_contacts(&mut motion, rig, &ContactOptions::default());
     }
-    let motion = if (motion.fps() - source.fps()).abs() > 1e-3 * source.fps() {
-        resample_fps(&motion, source.fps())?
+    let motion = if (motion.fps() - source.fps).abs() > 1e-3 * source.fps {
+        resample_fps(&motion, source.fps)?
     } else {
         motion
     };
@@ -337,7 +429,7 @@ pub fn restyle(
         conversion,
         timings,
         root_shift,
-        asymmetry_window_s,
+        asymmetry_window_s: source.asymmetry_window_s,
     })
 }
 

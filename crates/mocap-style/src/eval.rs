@@ -32,7 +32,9 @@ use mocap_core::{forward_kinematics, Motion};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
-use crate::apply::{load_model, prepare_style, restyle, StageTimings, StyleClip};
+use crate::apply::{
+    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings, StyleClip,
+};
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
 use crate::contact::{heights_above_ground, travelled};
@@ -712,6 +714,8 @@ fn evaluate_set(
     let bar = mocap_nn::train::work_bar(sources.len() as u64, &format!("{set}: sources restyled"));
     for source in &sources {
         let source_distance = travelled(&source.motion, rig);
+        // Encoded once for all its pairs; each pair's timings include it.
+        let prepared_source = prepare_source(model, &source.motion, options.convert.asymmetry)?;
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
                 continue;
@@ -721,9 +725,9 @@ fn evaluate_set(
                     method,
                     ..options.convert
                 };
-                let restyled = restyle(
+                let restyled = restyle_prepared(
                     model,
-                    &source.motion,
+                    &prepared_source,
                     &[(&prepared[k], 1.0)],
                     &convert,
                     prepare_times[k],
@@ -926,14 +930,15 @@ fn draw_filmstrips(
         used_sources.push(i);
         let (source, style) = (sources[i], style_clips[k]);
         let mut outputs = Vec::new();
+        let prepared_source = prepare_source(model, &source.motion, options.convert.asymmetry)?;
         for &method in &options.methods {
             let convert = ConvertOptions {
                 method,
                 ..options.convert
             };
-            let r = restyle(
+            let r = restyle_prepared(
                 model,
-                &source.motion,
+                &prepared_source,
                 &[(&prepared[k], 1.0)],
                 &convert,
                 prepare_times[k],
