@@ -1146,8 +1146,9 @@ mod tests {
 
     /// Step 6: a source held off-centre by `d` (its mirror by `-d`, half a
     /// stride later) comes out `strength * d` away from the same conversion
-    /// with the style's symmetric mean, at every frame and for every method;
-    /// without its mirror it is refused.
+    /// with the style's symmetric mean, at every frame and for every method,
+    /// averaged over the whole clip or over two strides; without the
+    /// asymmetry track (made from the mirror) it is refused.
     #[test]
     fn the_source_asymmetry_is_kept() {
         let d = [0.3f32, -0.2, 0.0, 0.1, 0.0, 0.05];

@@ -303,6 +303,37 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     assert!(wrong.len() <= 1, "{wrong:?}");
 }
 
+/// The shipped model and the held-out dataset-2 active walk, prepared as
+/// the style clip of the turn tests; `None` without the data.
+fn model_and_active_walk() -> Option<(StyleModel, mocap_style::apply::StyleClip)> {
+    let path = bandai("dataset-2", "dataset-2_walk_active_031.bvh")?;
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let mut t = StageTimings::default();
+    let clip = prepare_style(&model, &read_bvh(&path).unwrap(), "style", &mut t).unwrap();
+    Some((model, clip))
+}
+
+/// `source` restyled with `clip` by the default settings but `asymmetry`.
+fn restyled_with(
+    model: &StyleModel,
+    clip: &mocap_style::apply::StyleClip,
+    source: &mocap_core::Motion,
+    asymmetry: mocap_style::convert::Asymmetry,
+) -> mocap_style::apply::Restyled {
+    let options = ConvertOptions {
+        asymmetry,
+        ..ConvertOptions::default()
+    };
+    restyle(
+        model,
+        source,
+        &[(clip, 1.0)],
+        &options,
+        StageTimings::default(),
+    )
+    .unwrap()
+}
+
 /// Restyled turns keep their turn. In a right turn the feet land to one
 /// side of the pelvis (in the body's own frame), where a straight walk's
 /// are about centred; the style's symmetric statistics and a straight
@@ -318,12 +349,9 @@ fn restyled_turns_keep_their_sideways_footwork() {
     use mocap_style::convert::Asymmetry;
 
     let feet_offset = |motion: &mocap_core::Motion| feet_sideways_offset(motion).unwrap();
-    let Some(sty) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
+    let Some((model, clip)) = model_and_active_walk() else {
         return;
     };
-    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
-    let mut t = StageTimings::default();
-    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
     let mut errors = [0.0f64; 2];
     for take in [
         "active_040",
@@ -343,11 +371,7 @@ fn restyled_turns_keep_their_sideways_footwork() {
             .into_iter()
             .enumerate()
         {
-            let options = ConvertOptions {
-                asymmetry,
-                ..ConvertOptions::default()
-            };
-            let out = restyle(&model, &source, &[(&clip, 1.0)], &options, t).unwrap();
+            let out = restyled_with(&model, &clip, &source, asymmetry);
             let got = feet_offset(&out.motion);
             eprintln!("{take} {asymmetry:?}: feet offset {got:.4}, source {wanted:.4}");
             errors[k] += (got - wanted).abs() / 6.0;
@@ -381,12 +405,9 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
     use mocap_core::ops::trim;
     use mocap_style::convert::Asymmetry;
 
-    let Some(sty) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
+    let Some((model, clip)) = model_and_active_walk() else {
         return;
     };
-    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
-    let mut t = StageTimings::default();
-    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
     let mut errors = [0.0f64; 2];
     for (walk, turn) in [
         ("elderly_016", "elderly_028"),
@@ -414,11 +435,7 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
             .into_iter()
             .enumerate()
         {
-            let options = ConvertOptions {
-                asymmetry,
-                ..ConvertOptions::default()
-            };
-            let out = restyle(&model, &source, &[(&clip, 1.0)], &options, t).unwrap();
+            let out = restyled_with(&model, &clip, &source, asymmetry);
             if asymmetry == Asymmetry::Source {
                 let window = out.asymmetry_window_s.expect("a gait");
                 assert!((1.5..3.0).contains(&window), "two strides: {window} s");
