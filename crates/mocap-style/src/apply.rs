@@ -40,8 +40,8 @@ use crate::contact::{
     clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions, RootShift,
 };
 use crate::convert::{
-    asymmetry_track, convert, Asymmetry, Conversion, ConvertOptions, Latents, Method, RootPath,
-    StyleInput,
+    asymmetry_track, asymmetry_window, convert, Asymmetry, Conversion, ConvertOptions, Latents,
+    Method, RootPath, StyleInput,
 };
 use crate::data::mirrored;
 use crate::eval::gait_period;
@@ -296,10 +296,10 @@ pub fn prepare_source(
     };
     // A source without a gait, or shorter than two strides, keeps one
     // offset for the whole clip.
-    let asymmetry_window_s = match asymmetry {
-        Asymmetry::Source => gait_period(&src, rig)
-            .map(|stride| 2.0 * stride)
-            .filter(|&window| ((window * src.fps()).round() as usize) < src.frame_count()),
+    let window_frames = match asymmetry {
+        Asymmetry::Source => gait_period(&src, rig).and_then(|stride| {
+            asymmetry_window(Some((2.0 * stride * src.fps()) as f32), src.frame_count())
+        }),
         Asymmetry::SourceClip | Asymmetry::Style => None,
     };
     timings.prepare += t.elapsed().as_secs_f64();
@@ -311,12 +311,10 @@ pub fn prepare_source(
 
     let t = Instant::now();
     let asymmetry_track = mirror_latents
-        .map(|mirror| {
-            let window = asymmetry_window_s.map(|s| (s * src.fps()) as f32);
-            asymmetry_track(&latents, &mirror, window)
-        })
+        .map(|mirror| asymmetry_track(&latents, &mirror, window_frames.map(|l| l as f32)))
         .transpose()?;
     timings.matching += t.elapsed().as_secs_f64();
+    let asymmetry_window_s = window_frames.map(|l| l as f64 / src.fps());
     Ok(PreparedSource {
         leg_length: rig.leg_length(src.skeleton()),
         motion: src,

@@ -714,14 +714,25 @@ pub fn asymmetry_track(
         .zip(&mirror.data)
         .map(|(&x, &m)| 0.5 * (x as f64 - m as f64))
         .collect();
-    let window = window_frames
-        .map(|l| l.round().max(1.0) as usize)
-        .filter(|&l| l < frames);
+    let window = asymmetry_window(window_frames, frames);
+    let data = windowed_mean(&half_difference, dim, window);
+    Latents::new(frames, dim, data)
+}
+
+/// The mean of each of the `dim` channels of `values` (frame after frame)
+/// around each frame: over a Hann window of `window` frames that stays
+/// whole inside the clip (its first and last half-windows hold the value
+/// at the ends), or over the whole clip when `window` is `None`. A Hann
+/// window of `l` frames has a spectrum that vanishes at every multiple of
+/// 2/l cycles per frame, so with `l` two strides long it cancels whatever
+/// repeats with the stride ([`asymmetry_track`]).
+pub fn windowed_mean(values: &[f64], dim: usize, window: Option<usize>) -> Vec<f32> {
+    let frames = values.len() / dim.max(1);
     let mut data = Vec::with_capacity(frames * dim);
-    match window {
+    match window.filter(|&l| l >= 1 && l < frames) {
         None => {
             let mut mean = vec![0.0f64; dim];
-            for row in half_difference.chunks_exact(dim) {
+            for row in values.chunks_exact(dim) {
                 mean.iter_mut().zip(row).for_each(|(m, d)| *m += d);
             }
             let n = frames.max(1) as f64;
@@ -731,8 +742,6 @@ pub fn asymmetry_track(
             }
         }
         Some(l) => {
-            // Hann weights over `l` frames (their spectrum vanishes at every
-            // multiple of 2/l cycles per frame).
             let weights: Vec<f64> = (0..l)
                 .map(|k| {
                     let phase = std::f64::consts::TAU * (k as f64 + 0.5) / l as f64;
@@ -747,14 +756,23 @@ pub fn asymmetry_track(
                     .clamp(0.0, (frames - l) as f64) as usize;
                 mean.iter_mut().for_each(|m| *m = 0.0);
                 for (k, w) in weights.iter().enumerate() {
-                    let row = &half_difference[(start + k) * dim..(start + k + 1) * dim];
+                    let row = &values[(start + k) * dim..(start + k + 1) * dim];
                     mean.iter_mut().zip(row).for_each(|(m, d)| *m += w * d);
                 }
                 data.extend(mean.iter().map(|m| (m / total) as f32));
             }
         }
     }
-    Latents::new(frames, dim, data)
+    data
+}
+
+/// The window [`asymmetry_track`] averages over, in frames, for a window of
+/// `window_frames` asked on a clip of `frames`: `None` (the whole clip) when
+/// none is asked or the clip is no longer than it.
+pub fn asymmetry_window(window_frames: Option<f32>, frames: usize) -> Option<usize> {
+    window_frames
+        .map(|l| l.round().max(1.0) as usize)
+        .filter(|&l| l < frames)
 }
 
 fn mean_height(sequences: &[(Latents, Vec<f32>)]) -> f32 {
