@@ -6,8 +6,11 @@
 # as the evaluation), with the source's left-right asymmetry kept (the default)
 # and without it (`--asymmetry style`, the report's method), then placed between
 # real straight walks and real right turns on the pose values that tell those
-# apart most (example feature_contrast); the sources the same way. About a
-# minute. Output: bench/style/out/turn-cues.md.
+# apart most (example feature_contrast); the sources the same way. Then the
+# feet's sideways offset split into its slow change along the clip and the
+# swing within each stride (example turn_swing), for real walks and turns,
+# the sources and the outputs of every asymmetry setting. About a minute.
+# Output: bench/style/out/turn-cues.md.
 source "$(dirname "$0")/setup.sh"
 cargo build -q --profile test -p mocap-cli
 MOCAP=$CARGO_TARGET_DIR/debug/mocap
@@ -35,4 +38,8 @@ done
   echo "## Their sources"
   echo
   "$BIN/feature_contrast" "$D2" walk-turn-right walk "${SOURCES[@]}" --top 10
+  echo
+  echo "## The feet's sideways offset: its slow change along the clip, and the swing within a stride"
+  echo
+  "$BIN/turn_swing" "$D2" "$D2/dataset-2_walk_active_031.bvh" "${SOURCES[@]}"
 } > "$OUT/turn-cues.md"
