@@ -22,11 +22,11 @@ use std::path::PathBuf;
 use mocap_core::io::read_motion;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_search::features::{motion_features, VALUE_NAMES};
+use mocap_search::features::motion_features;
 use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
 use mocap_style::convert::{windowed_mean, Asymmetry, ConvertOptions};
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-use mocap_style::eval::gait_period;
+use mocap_style::eval::{gait_period, sideways_ankle_values};
 use mocap_style::features::RigLayout;
 
 /// (slow, swing) standard deviations of the left and right ankles' sideways
@@ -36,8 +36,7 @@ fn slow_and_swing(motion: &Motion) -> Option<[[f64; 2]; 2]> {
     let stride = gait_period(motion, &rig)?;
     let window = (2.0 * stride * motion.fps()).round() as usize;
     let features = motion_features(motion).expect("pose values");
-    let index = |name: &str| VALUE_NAMES.iter().position(|n| *n == name).unwrap();
-    let ankles = [index("left_ankle.x"), index("right_ankle.x")];
+    let ankles = sideways_ankle_values();
     let frames = features.values.len() / features.dim;
     let series: Vec<f64> = (0..frames)
         .flat_map(|f| ankles.map(|a| features.values[f * features.dim + a] as f64))

@@ -368,20 +368,29 @@ pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
     }
 }
 
-/// The mean over frames of the two ankles' sideways offsets from the pelvis
-/// in the body frame (body heights; mocap-search's pose values
-/// `left_ankle.x` and `right_ankle.x`). About zero in a straight walk, well
-/// off it in a turn (its feet land to one side): how turn_cues.sh and the
-/// tests tell whether a restyled turn kept its footwork.
-pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
-    let index = |name: &str| {
+/// Where the left and the right ankle's sideways offsets from the pelvis
+/// (body frame, body heights) are among mocap-search's per-frame pose values
+/// (`left_ankle.x`, `right_ankle.x`).
+pub fn sideways_ankle_values() -> [usize; 2] {
+    ["left_ankle.x", "right_ankle.x"].map(|name| {
         mocap_search::features::VALUE_NAMES
             .iter()
             .position(|n| *n == name)
             .expect("a pose value of mocap-search")
-    };
+    })
+}
+
+/// The mean over frames of the two ankles' sideways offsets from the pelvis
+/// in the body frame ([`sideways_ankle_values`], summed). About zero in a
+/// straight walk, well off it in a turn (its feet land to one side): how
+/// turn_cues.sh and the tests tell whether a restyled turn kept its
+/// footwork.
+pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
     let statistics = crate::classify::clip_pose_statistics(motion)?;
-    Ok((statistics[index("left_ankle.x")] + statistics[index("right_ankle.x")]) as f64)
+    Ok(sideways_ankle_values()
+        .iter()
+        .map(|&i| statistics[i] as f64)
+        .sum())
 }
 
 /// Mean jerk of all joints (see [`mocap_core::metrics::jitter`]).
