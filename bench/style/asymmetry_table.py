@@ -6,9 +6,10 @@ kept as one offset per clip (`--asymmetry source-clip`) and not kept
 Usage: python3 bench/style/asymmetry_table.py RUNS_DIR > bench/style/out/asymmetry.md
 RUNS_DIR holds eval-{style,source-clip}-{last,first}.json.
 """
-import json
 import pathlib
 import sys
+
+from reports import method_row, pooled
 
 OUT = pathlib.Path(__file__).resolve().parent / "out"
 RUNS_DIR = pathlib.Path(sys.argv[1])
@@ -23,12 +24,6 @@ RUNS = {
 METHODS = ["elastic-patches", "fixed-patches", "whitening-colouring", "adain"]
 
 
-def method_row(path, data_set, method):
-    report = json.loads(path.read_text())
-    s = next(x for x in report["sets"] if x["set"] == data_set)
-    return next(x for x in s["methods"] if x["method"] == method)
-
-
 print("Style and content accuracy (judge seed 1) on the shipped fold (last take held out) /")
 print("the other fold (first take held out) / both pooled; |T_out - T_style|, foot skating")
 print("and jitter pooled over both folds.\n")
@@ -38,17 +33,13 @@ for data_set in ["dataset-1", "dataset-2"]:
     for method in METHODS:
         for asymmetry, paths in RUNS.items():
             rows = [method_row(p, data_set, method) for p in paths]
-            pairs = sum(r["pairs"] for r in rows)
-
-            def pooled(key):
-                return sum(r[key] * r["pairs"] for r in rows) / pairs
 
             def folds(key):
-                cells = [f"{100 * r[key]:.1f}" for r in rows] + [f"{100 * pooled(key):.1f}%"]
+                cells = [f"{100 * r[key]:.1f}" for r in rows] + [f"{100 * pooled(rows, key):.1f}%"]
                 return " / ".join(cells)
 
             print(
                 f"| {data_set} | {method} | {asymmetry} | {folds('style_accuracy')} "
-                f"| {folds('content_accuracy')} | {pooled('period_error_to_style'):.3f} "
-                f"| {pooled('foot_skating'):.1f} | {pooled('jitter'):.3f} |"
+                f"| {folds('content_accuracy')} | {pooled(rows, 'period_error_to_style'):.3f} "
+                f"| {pooled(rows, 'foot_skating'):.1f} | {pooled(rows, 'jitter'):.3f} |"
             )

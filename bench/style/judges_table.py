@@ -9,6 +9,8 @@ import json
 import pathlib
 import sys
 
+from reports import method_row, pooled
+
 root = pathlib.Path(sys.argv[1])
 JUDGES = ["forest", "conv-net"]
 FOLDS = ["last", "first"]
@@ -46,21 +48,14 @@ print("| --- | --- | --- | --- | --- | --- | --- | --- |")
 for data_set in ["dataset-1", "dataset-2"]:
     for method in METHODS:
         for judge in JUDGES:
-            cells, style_sum, content_sum, pairs_sum = [], 0.0, 0.0, 0
-            for seed in SEEDS:
-                style = content = pairs = 0
-                for fold in FOLDS:
-                    report = load("eval", judge, fold, seed)
-                    s = next(x for x in report["sets"] if x["set"] == data_set)
-                    m = next(x for x in s["methods"] if x["method"] == method)
-                    style += m["style_accuracy"] * m["pairs"]
-                    content += m["content_accuracy"] * m["pairs"]
-                    pairs += m["pairs"]
-                cells.append(f"{100 * style / pairs:.1f}%")
-                style_sum += style
-                content_sum += content
-                pairs_sum += pairs
+            rows = {
+                seed: [method_row(load("eval", judge, fold, seed), data_set, method) for fold in FOLDS]
+                for seed in SEEDS
+            }
+            every = [r for seed in SEEDS for r in rows[seed]]
+            cells = [f"{100 * pooled(rows[seed], 'style_accuracy'):.1f}%" for seed in SEEDS]
             print(
                 f"| {data_set} | {method} | {judge} | {' | '.join(cells)} "
-                f"| {100 * style_sum / pairs_sum:.1f}% | {100 * content_sum / pairs_sum:.1f}% |"
+                f"| {100 * pooled(every, 'style_accuracy'):.1f}% "
+                f"| {100 * pooled(every, 'content_accuracy'):.1f}% |"
             )
