@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use mocap_core::io::bvh::read_bvh;
-use mocap_style::eval::foot_skating;
+use mocap_style::eval::{foot_skating, planted_foot_sliding};
 use mocap_style::features::RigLayout;
 
 fn mocap(args: &[&str]) -> Output {
@@ -524,6 +524,24 @@ fn style_apply_restyles_the_bundled_walk() {
         "root shift {} and {}",
         shift(&along_report),
         shift(&feet_report)
+    );
+
+    // The foot-contact cleanup says what it changed; without it, nothing.
+    let (contacts_report, contacts_motion) = restyle(&["--foot-contacts"]);
+    assert!(along_report["contacts"].is_null());
+    let contacts = &contacts_report["contacts"];
+    for side in 0..2 {
+        assert!(
+            contacts["frames_changed"][side].as_u64().unwrap() > 0,
+            "{contacts}"
+        );
+    }
+    let max_shift = contacts["max_shift"].as_f64().unwrap();
+    let leg = rig.leg_length(contacts_motion.skeleton()) as f64;
+    assert!(0.0 < max_shift && max_shift < 0.5 * leg, "{contacts}");
+    assert!(
+        planted_foot_sliding(&contacts_motion, &rig) < planted_foot_sliding(&along_motion, &rig),
+        "{contacts}"
     );
 
     // The source's left-right asymmetry is kept by default; `--asymmetry

@@ -37,7 +37,8 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::{
-    clean_foot_contacts, root_from_feet, travelled, ContactOptions, RootFromFeetOptions, RootShift,
+    clean_foot_contacts, root_from_feet, travelled, ContactOptions, ContactReport,
+    RootFromFeetOptions, RootShift,
 };
 use crate::convert::{
     asymmetry_track, asymmetry_window, convert, Asymmetry, Conversion, ConvertOptions, Latents,
@@ -210,6 +211,8 @@ pub struct Restyled {
     /// How far the feet moved the root from the source's path (file units;
     /// zero with [`RootPath::Source`]).
     pub root_shift: RootShift,
+    /// What the foot-contact cleanup changed (`None`: not asked for).
+    pub contacts: Option<ContactReport>,
     /// Seconds over which the source's asymmetry was averaged (two of its
     /// strides); `None`: over the whole clip, or not kept.
     pub asymmetry_window_s: Option<f64>,
@@ -413,9 +416,9 @@ pub fn restyle_prepared(
     let root_shift = RootFromFeetOptions::for_path(options.root)
         .map(|feet| root_from_feet(&mut motion, rig, &feet))
         .unwrap_or_default();
-    if options.foot_contacts {
-        clean_foot_contacts(&mut motion, rig, &ContactOptions::default());
-    }
+    let contacts = options
+        .foot_contacts
+        .then(|| clean_foot_contacts(&mut motion, rig, &ContactOptions::default()));
     let motion = if (motion.fps() - source.fps).abs() > 1e-3 * source.fps {
         resample_fps(&motion, source.fps)?
     } else {
@@ -427,6 +430,7 @@ pub fn restyle_prepared(
         conversion,
         timings,
         root_shift,
+        contacts,
         asymmetry_window_s: source.asymmetry_window_s,
     })
 }
@@ -469,6 +473,11 @@ pub struct ApplyReport {
     /// horizontally (file units, on the model's rig).
     pub root_shift: RootShift,
     pub foot_contacts: bool,
+    /// What the foot-contact cleanup changed, with `foot_contacts`: frames
+    /// per foot, how far the ankles were moved (file units, on the model's
+    /// rig), and frames held back by the leg's reach.
+    #[serde(default)]
+    pub contacts: Option<ContactReport>,
     pub asymmetry: Asymmetry,
     /// Seconds over which the source's asymmetry was averaged (two of its
     /// strides, [`Asymmetry::Source`]); `None`: over the whole clip (a
@@ -699,6 +708,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         patch: options.patch,
         root: options.root,
         root_shift: restyled.root_shift,
+        contacts: restyled.contacts,
         foot_contacts: options.foot_contacts,
         asymmetry: options.asymmetry,
         asymmetry_window_s: restyled.asymmetry_window_s,

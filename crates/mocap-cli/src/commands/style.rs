@@ -119,8 +119,8 @@ struct ApplyArgs {
     /// Same as `--root feet`.
     #[arg(long, conflicts_with = "root")]
     root_from_feet: bool,
-    /// Pin the ankles on the ground by turning hips and knees (keeps the source's path; costs
-    /// some style, see bench/results/style.md).
+    /// Pin the ankles on the ground by turning hips and knees, no further than the legs reach
+    /// (keeps the source's path; costs some style, see bench/results/style.md).
     #[arg(long)]
     foot_contacts: bool,
     /// Whose left-right asymmetry the output keeps: `source` (default: the source's, averaged
@@ -293,6 +293,18 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 }
                 if let Some(note) = report.unfamiliar_source_note() {
                     eprintln!("note: {note}");
+                }
+                if let Some(c) = &report.contacts {
+                    eprintln!(
+                        "feet pinned on {} and {} frames (left, right): ankles moved {:.1} on \
+                         average, {:.1} at most (the model rig's units); held back by the legs' \
+                         reach on {} frames",
+                        c.frames_changed[0],
+                        c.frames_changed[1],
+                        c.mean_shift,
+                        c.max_shift,
+                        c.frames_out_of_reach
+                    );
                 }
                 eprintln!(
                     "wrote {} ({} frames from {}; time scale {:.2}, distance ratio {:.2})",
