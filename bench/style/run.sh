@@ -7,8 +7,9 @@
 #   bash bench/style/run.sh --classifiers  # also compare the evaluation's classifiers
 #                                          # on real clips (held out + cross-validation)
 #   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
-#   bash bench/style/run.sh --contacts # also patches with foot-contact cleanup and with
-#                                      # the root carried by the feet everywhere (both opt-in)
+#   bash bench/style/run.sh --contacts # also the foot-contact cleanup (example foot_cleanup,
+#                                      # and patches with it) and the root carried by the
+#                                      # feet everywhere (both opt-in)
 #   bash bench/style/run.sh --other-fold  # also the whole evaluation on the other fold:
 #                                      # the first take of each group held out (~10 min)
 # (flags combine)
@@ -69,6 +70,16 @@ if flag --patches; then
 fi
 
 if flag --contacts; then
+  # The foot-contact cleanup before and after session 18, how much the feet
+  # slide in the sources, through the autoencoder alone and in the outputs,
+  # and the cleanup's reach limit (no classifiers: a few seconds).
+  "$BIN/foot_cleanup" --reach-limits 0.99,1,1.05,1.1 --height-tolerances 0.02,0.05 \
+    "$DATA/dataset-1" "$DATA/dataset-2" \
+    > "$OUT/foot-cleanup.md"
+  # The cleanup with the default root, judged as the main run.
+  "$BIN/style_eval" --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
+    --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-contacts-default-root.json" \
+    --markdown "$OUT/eval-contacts-default-root.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
   # Foot-contact cleanup (two-bone IK pinning the ankles on the ground),
   # off by default: its trade-off is measured here, with the source's root.
   "$BIN/style_eval" --root source --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
