@@ -24,6 +24,7 @@
 
 use burn::tensor::Tensor;
 use mocap_core::Skeleton;
+use mocap_nn::kinematics::{child_position, compose, Columns};
 
 use crate::features::{FeatureLayout, Representation, RotationFrame};
 use crate::{CleanError, Result};
@@ -36,9 +37,6 @@ pub struct FkSkeleton {
     /// Feature joint index (in the layout) of each skeleton joint.
     feature: Vec<Option<usize>>,
 }
-
-/// Columns of a batch of rotation matrices, each `[batch, 3, frames]`.
-type Columns = [Tensor<3>; 3];
 
 fn norm(v: &Tensor<3>) -> Tensor<3> {
     // The clamp keeps degenerate (zero) columns finite; trained features are
@@ -58,13 +56,6 @@ fn rotate2(v: &Tensor<3>) -> Tensor<3> {
         vec![v.clone().narrow(1, 2, 1), v.clone().narrow(1, 0, 2)],
         1,
     )
-}
-
-/// `R v` for rotations given by columns and vectors `[batch, 3, frames]`.
-fn apply(r: &Columns, v: &Tensor<3>) -> Tensor<3> {
-    r[0].clone() * v.clone().narrow(1, 0, 1)
-        + r[1].clone() * v.clone().narrow(1, 1, 1)
-        + r[2].clone() * v.clone().narrow(1, 2, 1)
 }
 
 /// The rotation of one joint's 6D features `[batch, 6, frames]`.
@@ -130,14 +121,9 @@ impl FkSkeleton {
                 }
                 Some(p) => {
                     let rp = &rotations[*p];
-                    let o = self.offsets[j];
-                    let position = positions[*p].clone()
-                        + rp[0].clone() * o[0]
-                        + rp[1].clone() * o[1]
-                        + rp[2].clone() * o[2];
+                    let position = child_position(positions[*p].clone(), rp, self.offsets[j]);
                     let rotation = match local {
-                        // Column i of R_p L_j is R_p applied to column i of L_j.
-                        Some(l) => l.map(|column| apply(rp, &column)),
+                        Some(l) => compose(rp, &l),
                         None => rp.clone(),
                     };
                     (rotation, position)

@@ -1051,3 +1051,58 @@ fn style_eval_names_its_judges_and_settings_and_can_judge_style_with_the_conv_ne
         stderr(&out)
     );
 }
+
+/// `style train` writes a model and its report; the loss on the feet is
+/// added to the reconstruction error (same seed, same windows: a larger
+/// training loss), and a negative weight is refused.
+#[test]
+fn style_train_adds_the_loss_on_the_feet_when_asked() {
+    let Some(data) = mocap_testdata::shared_data() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let takes = dir.path().join("walks");
+    std::fs::create_dir(&takes).unwrap();
+    for name in [
+        "dataset-2_walk_active_001.bvh",
+        "dataset-2_walk_active_004.bvh",
+        "dataset-2_walk_elderly_001.bvh",
+        "dataset-2_walk_elderly_004.bvh",
+    ] {
+        std::fs::copy(data.join("bandai/dataset-2").join(name), takes.join(name)).unwrap();
+    }
+    let train = |weight: &str| {
+        let model = dir.path().join(format!("style-{weight}.safetensors"));
+        let out = mocap(&[
+            "style",
+            "train",
+            path(&takes),
+            "-o",
+            path(&model),
+            "--epochs",
+            "1",
+            "--steps",
+            "3",
+            "--window",
+            "64",
+            "--no-hold-out",
+            &format!("--foot-loss={weight}"),
+            "--json",
+        ]);
+        (out, model)
+    };
+    let loss = |weight: &str| {
+        let (out, model) = train(weight);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(model.is_file());
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        report["history"]["epochs"][0]["train_loss"]
+            .as_f64()
+            .unwrap()
+    };
+    let (plain, feet) = (loss("0"), loss("300"));
+    assert!(plain.is_finite() && feet > plain, "{plain} -> {feet}");
+    let (out, _) = train("-1");
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("foot loss"), "{}", stderr(&out));
+}

@@ -1,7 +1,7 @@
 //! # mocap-nn
 //!
 //! The neural-network glue shared by the learned mocap capabilities (the
-//! denoiser of `mocap-clean`, and later style transfer), so that each of them
+//! denoiser of `mocap-clean` and the autoencoder of `mocap-style`), so that each of them
 //! only writes its model and its data:
 //!
 //! - [`device`]: which device runs the network (the pure-Rust `flex` CPU
@@ -11,12 +11,15 @@
 //!   trained on; resumable training state;
 //! - [`train`]: an epoch loop with a progress bar (hidden when stderr is not a
 //!   terminal), loss history, and one Adam step;
-//! - [`plot`]: loss curves as PNG.
+//! - [`plot`]: loss curves as PNG;
+//! - [`kinematics`]: forward kinematics on tensors, for losses on joint
+//!   positions.
 //!
 //! `burn` is re-exported so that dependent crates use the very same version.
 
 pub mod checkpoint;
 pub mod device;
+pub mod kinematics;
 pub mod plot;
 pub mod train;
 

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p mocap-style --example style_train -- \
-//!     [--epochs 30] [--steps 100] [--contents walk,walk-back] [--seed 1] \
+//!     [--epochs 30] [--steps 100] [--contents walk,walk-back] [--seed 1] [--foot-loss W] \
 //!     -o models/style-default.safetensors DIR...
 //! ```
 
@@ -27,6 +27,7 @@ fn main() {
             "--no-hold-out" => options.hold_out = false,
             "--held-out" => options.held_out_take = value().parse().expect("--held-out last|first"),
             "--resume" => options.resume = true,
+            "--foot-loss" => options.foot_loss_weight = value().parse().expect("--foot-loss W"),
             _ => options.inputs.push(PathBuf::from(a)),
         }
     }

@@ -48,6 +48,7 @@ pub mod data;
 pub mod eval;
 pub mod features;
 pub mod filmstrip;
+pub mod foot_loss;
 pub mod linalg;
 pub mod model;
 pub mod train;

@@ -7,7 +7,9 @@
 //! window of `window` frames from each, uniformly (report: 240 frames, batch
 //! 16, Adam, learning rate 1e-4); when a drawn clip is shorter than the
 //! window, the whole batch uses that clip's length, so short takes are not
-//! padded. The loss is the mean squared error of the reconstruction.
+//! padded. The loss is the mean squared error of the reconstruction, plus,
+//! with [`TrainOptions::foot_loss_weight`], a loss on the feet
+//! ([`crate::foot_loss`]).
 //!
 //! Reproducibility: the weights are initialised from `seed` and the windows
 //! of epoch `e` come from a generator seeded with `(seed, e)`, so a resumed
@@ -38,6 +40,7 @@ use crate::data::{
     held_out, labelled_paths, list_bvh, load_clips, mirrored, ClipFilter, HeldOutTake,
 };
 use crate::features::{decompose, Normalization, RigLayout};
+use crate::foot_loss::{contacts_tensor, flat_foot_steps, FootKinematics};
 use crate::model::{AutoencoderConfig, StyleAutoencoder};
 use crate::{invalid, Result};
 
@@ -89,6 +92,10 @@ pub struct TrainOptions {
     pub resume: bool,
     /// Hidden and latent sizes and kernel (channels come from the data).
     pub network: AutoencoderConfig,
+    /// Weight of the loss on the feet ([`crate::foot_loss`]) added to the
+    /// reconstruction error; 0: the report's loss alone.
+    #[serde(default)]
+    pub foot_loss_weight: f64,
 }
 
 impl Default for TrainOptions {
@@ -112,6 +119,7 @@ impl Default for TrainOptions {
             state_dir: None,
             resume: false,
             network: AutoencoderConfig::report(0),
+            foot_loss_weight: 0.0,
         }
     }
 }
@@ -260,6 +268,8 @@ fn from_tensor(tensor: Tensor<3>, frames: usize) -> Result<Latents> {
 struct FeatureClip {
     frames: usize,
     features: Vec<f32>,
+    /// [`crate::foot_loss::flat_foot_steps`] of the clip.
+    contacts: Vec<f32>,
 }
 
 /// Draws training batches.
@@ -268,10 +278,17 @@ struct WindowSampler<'a> {
     cumulative: Vec<usize>,
     channels: usize,
     window: usize,
+    /// Foot joints per contact step.
+    feet: usize,
 }
 
 impl<'a> WindowSampler<'a> {
-    fn new(clips: &'a [FeatureClip], channels: usize, window: usize) -> WindowSampler<'a> {
+    fn new(
+        clips: &'a [FeatureClip],
+        channels: usize,
+        window: usize,
+        feet: usize,
+    ) -> WindowSampler<'a> {
         let mut total = 0;
         let cumulative = clips
             .iter()
@@ -285,11 +302,13 @@ impl<'a> WindowSampler<'a> {
             cumulative,
             channels,
             window,
+            feet,
         }
     }
 
-    /// A batch `[size, channels, frames]` and its frame count.
-    fn batch(&self, rng: &mut ChaCha8Rng, size: usize) -> (Vec<f32>, usize) {
+    /// A batch `[size, channels, frames]`, its frame count, and the contact
+    /// steps of its windows (`frames - 1` steps of `feet` values each).
+    fn batch(&self, rng: &mut ChaCha8Rng, size: usize) -> (Vec<f32>, usize, Vec<f32>) {
         let total = *self.cumulative.last().expect("training clips");
         let picked: Vec<usize> = (0..size)
             .map(|_| {
@@ -305,6 +324,7 @@ impl<'a> WindowSampler<'a> {
             .min(self.window);
         let c = self.channels;
         let mut x = vec![0.0; size * c * frames];
+        let mut contacts = Vec::with_capacity(size * frames.saturating_sub(1) * self.feet);
         for (b, &i) in picked.iter().enumerate() {
             let clip = &self.clips[i];
             let start = rng.random_range(0..=clip.frames - frames);
@@ -313,14 +333,23 @@ impl<'a> WindowSampler<'a> {
                     x[(b * c + ch) * frames + f] = clip.features[(start + f) * c + ch];
                 }
             }
+            // Step k of the clip goes from frame k to k + 1.
+            let steps = frames.saturating_sub(1) * self.feet;
+            contacts.extend_from_slice(&clip.contacts[start * self.feet..][..steps]);
         }
-        (x, frames)
+        (x, frames, contacts)
     }
 }
 
 /// Trains an autoencoder (see the module docs).
 pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let started = Instant::now();
+    if !(options.foot_loss_weight >= 0.0 && options.foot_loss_weight.is_finite()) {
+        return Err(invalid(format!(
+            "the foot loss weight must be a number >= 0 (got {})",
+            options.foot_loss_weight
+        )));
+    }
     if options.batch_size == 0 || options.window < 16 || options.steps_per_epoch == 0 {
         return Err(invalid(
             "batch size, steps per epoch must be positive and the window at least 16 frames",
@@ -354,8 +383,9 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let rig = RigLayout::from_skeleton(first.motion.skeleton())?;
     let fps = first.motion.fps();
 
-    // Slot rotations of every clip (and mirror), at the first clip's rate.
-    let rotations_of = |clips: &[crate::data::Clip]| -> Result<Vec<Vec<Quat>>> {
+    // Slot rotations of every clip (and mirror), at the first clip's rate,
+    // with the frame steps where its feet are flat on the ground.
+    let rotations_of = |clips: &[crate::data::Clip]| -> Result<Vec<(Vec<Quat>, Vec<f32>)>> {
         let mut out = Vec::new();
         for clip in clips {
             rig.check_skeleton(clip.motion.skeleton(), &clip.path.display().to_string())?;
@@ -364,9 +394,12 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             } else {
                 clip.motion.clone()
             };
-            out.push(decompose(&motion, &rig).0);
+            let mut motions = vec![motion.clone()];
             if options.mirror {
-                out.push(decompose(&mirrored(&motion)?, &rig).0);
+                motions.push(mirrored(&motion)?);
+            }
+            for m in motions {
+                out.push((decompose(&m, &rig).0, flat_foot_steps(&m, &rig)));
             }
         }
         Ok(out)
@@ -377,16 +410,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let normalization = Normalization::fit(
         &train_rotations
             .iter()
-            .map(Vec::as_slice)
+            .map(|(r, _)| r.as_slice())
             .collect::<Vec<_>>(),
         slots,
     )?;
-    let to_features = |rotations: &[Vec<Quat>]| -> Vec<FeatureClip> {
+    let to_features = |rotations: &[(Vec<Quat>, Vec<f32>)]| -> Vec<FeatureClip> {
         rotations
             .iter()
-            .map(|r| FeatureClip {
+            .map(|(r, contacts)| FeatureClip {
                 frames: r.len() / slots,
                 features: normalization.features(r),
+                contacts: contacts.clone(),
             })
             .collect()
     };
@@ -444,7 +478,8 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         config: serde_json::to_value(&description).expect("serialisable"),
         data: serde_json::to_value(&data).expect("serialisable"),
         training: serde_json::json!({
-            "loss": "mse",
+            "loss": if options.foot_loss_weight > 0.0 { "mse + feet" } else { "mse" },
+            "foot_loss_weight": options.foot_loss_weight,
             "epochs": history.epochs.len(),
             "steps_per_epoch": options.steps_per_epoch,
             "batch_size": options.batch_size,
@@ -457,7 +492,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         }),
     };
 
-    let sampler = WindowSampler::new(&train_features, network.channels, options.window);
+    let feet = FootKinematics::new(
+        train_clips[0].motion.skeleton(),
+        &description.rig,
+        &description.normalization,
+    );
+    let sampler = WindowSampler::new(
+        &train_features,
+        network.channels,
+        options.window,
+        feet.feet(),
+    );
     struct Run {
         model: Option<StyleAutoencoder>,
         optimizer: burn::optim::ModuleOptimizer,
@@ -486,11 +531,22 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 );
                 run.rng_epoch = epoch;
             }
-            let (x, frames) = sampler.batch(&mut run.rng, options.batch_size);
+            let (x, frames, contacts) = sampler.batch(&mut run.rng, options.batch_size);
             let shape = [options.batch_size, network.channels, frames];
             let x = Tensor::<3>::from_data(TensorData::new(x, shape), &device);
             let model = run.model.take().expect("model present");
-            let loss = (model.forward(x.clone()) - x).powi_scalar(2).mean();
+            let output = model.forward(x.clone());
+            let mut loss = (output.clone() - x.clone()).powi_scalar(2).mean();
+            if options.foot_loss_weight > 0.0 && frames > 1 {
+                let contacts = contacts_tensor(
+                    &contacts,
+                    options.batch_size,
+                    feet.feet(),
+                    frames - 1,
+                    &device,
+                );
+                loss = loss + feet.loss(output, x, contacts) * options.foot_loss_weight;
+            }
             let (model, value) =
                 optimizer_step(model, &mut run.optimizer, loss, options.learning_rate);
             run.model = Some(model);

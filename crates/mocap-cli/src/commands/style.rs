@@ -54,6 +54,11 @@ struct TrainArgs {
     lr: Option<f64>,
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Weight of a loss on the feet added to the reconstruction error: flat feet of the clips
+    /// stay still in the reconstruction (0: the report's loss; measured with 300 in
+    /// bench/results/style.md, "A loss on the feet").
+    #[arg(long, default_value_t = 0.0, value_name = "W")]
+    foot_loss: f64,
     /// Do not add mirrored copies of the clips.
     #[arg(long)]
     no_mirror: bool,
@@ -238,6 +243,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 device: a.device,
                 plot: a.plot,
                 resume: a.resume,
+                foot_loss_weight: a.foot_loss,
                 ..defaults
             };
             if !a.contents.is_empty() {
