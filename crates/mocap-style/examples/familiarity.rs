@@ -16,22 +16,13 @@ use std::path::PathBuf;
 
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{load_model, source_reconstruction_deg};
-use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
+use mocap_style::data::{labelled_paths, list_bvh, ClipFilter, WALKING_CONTENTS};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut model_path = None;
     let mut inputs = Vec::new();
     // The shipped model's training contents (bench/style/run.sh).
-    let mut trained_on: Vec<String> = [
-        "walk",
-        "walk-back",
-        "walk-left",
-        "walk-right",
-        "walk-turn-left",
-        "walk-turn-right",
-    ]
-    .map(String::from)
-    .to_vec();
+    let mut trained_on: Vec<String> = WALKING_CONTENTS.map(String::from).to_vec();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {

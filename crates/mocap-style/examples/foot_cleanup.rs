@@ -36,18 +36,12 @@ use mocap_style::apply::{
 };
 use mocap_style::contact::{clean_foot_contacts, travelled, ContactOptions};
 use mocap_style::convert::ConvertOptions;
-use mocap_style::data::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter, HeldOutTake};
+use mocap_style::data::{
+    held_out, labelled_paths, list_bvh, load_clips, ClipFilter, HeldOutTake, WALKING_CONTENTS,
+};
 use mocap_style::eval::{foot_skating, largest_foot_reach, planted_foot_sliding};
 use mocap_style::features::RigLayout;
 
-const WALKS: [&str; 6] = [
-    "walk",
-    "walk-back",
-    "walk-left",
-    "walk-right",
-    "walk-turn-left",
-    "walk-turn-right",
-];
 const SOURCES: [&str; 3] = ["walk", "walk-turn-left", "walk-turn-right"];
 
 #[derive(Default, Clone, Copy)]
@@ -146,7 +140,7 @@ fn main() {
     let mut paces = Vec::new();
     for dir in &args {
         let filter = ClipFilter {
-            contents: WALKS.map(String::from).to_vec(),
+            contents: WALKING_CONTENTS.map(String::from).to_vec(),
             styles: Vec::new(),
         };
         let files = labelled_paths(&list_bvh(&[PathBuf::from(dir)]).expect("a folder"), &filter)

@@ -64,6 +64,18 @@ pub fn list_bvh(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(mocap_core::io::find_bvh_files(inputs)?)
 }
 
+/// The contents the shipped model was trained on and the evaluation's
+/// classifiers learn from: the Bandai walks, straight, back, sideways and
+/// turning (`bench/style/run.sh`).
+pub const WALKING_CONTENTS: [&str; 6] = [
+    "walk",
+    "walk-back",
+    "walk-left",
+    "walk-right",
+    "walk-turn-left",
+    "walk-turn-right",
+];
+
 /// Which labelled clips to use.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ClipFilter {

@@ -29,6 +29,31 @@ fn bandai(set: &str, name: &str) -> Option<PathBuf> {
     }
 }
 
+/// The shipped model, a dataset-1 source and a prepared style clip.
+struct Pair {
+    model: StyleModel,
+    source: mocap_core::Motion,
+    clip: mocap_style::apply::StyleClip,
+    timings: StageTimings,
+    rig: RigLayout,
+}
+
+fn dataset_1_pair(source: &str, style: &str) -> Option<Pair> {
+    let (src, sty) = (bandai("dataset-1", source)?, bandai("dataset-1", style)?);
+    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
+    let source = read_bvh(&src).unwrap();
+    let mut timings = StageTimings::default();
+    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut timings).unwrap();
+    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
+    Some(Pair {
+        model,
+        source,
+        clip,
+        timings,
+        rig,
+    })
+}
+
 /// The output keeps the source's skeleton and frame rate and follows the
 /// source's path; a style clip with a slower stride (proud: about 1.7 s)
 /// makes the outputs of faster walks longer with elastic patches, with a
@@ -128,17 +153,19 @@ fn restyled_walk_keeps_the_source_rig_and_takes_the_style_timing() {
 /// (bench/results/style.md, "How much the feet slide").
 #[test]
 fn same_style_transfer_keeps_the_feet_planted() {
-    let (Some(src), Some(sty)) = (
-        bandai("dataset-1", "dataset-1_walk_happy_002.bvh"),
-        bandai("dataset-1", "dataset-1_walk_happy_001.bvh"),
-    ) else {
+    let Some(Pair {
+        model,
+        source,
+        clip,
+        timings: t,
+        rig,
+    }) = dataset_1_pair(
+        "dataset-1_walk_happy_002.bvh",
+        "dataset-1_walk_happy_001.bvh",
+    )
+    else {
         return;
     };
-    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
-    let source = read_bvh(&src).unwrap();
-    let mut t = StageTimings::default();
-    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
-    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
     let out = restyle(
         &model,
         &source,
@@ -170,17 +197,16 @@ fn same_style_transfer_keeps_the_feet_planted() {
 /// leaves the rest of the sliding.
 #[test]
 fn the_contact_cleanup_keeps_a_shuffling_styles_legs_under_the_body() {
-    let (Some(src), Some(sty)) = (
-        bandai("dataset-1", "dataset-1_walk_happy_002.bvh"),
-        bandai("dataset-1", "dataset-1_walk_sad_002.bvh"),
-    ) else {
+    let Some(Pair {
+        model,
+        source,
+        clip,
+        timings: t,
+        rig,
+    }) = dataset_1_pair("dataset-1_walk_happy_002.bvh", "dataset-1_walk_sad_002.bvh")
+    else {
         return;
     };
-    let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
-    let source = read_bvh(&src).unwrap();
-    let mut t = StageTimings::default();
-    let clip = prepare_style(&model, &read_bvh(&sty).unwrap(), "style", &mut t).unwrap();
-    let rig = RigLayout::from_skeleton(source.skeleton()).unwrap();
     let restyled = |foot_contacts: bool| {
         let options = ConvertOptions {
             foot_contacts,
