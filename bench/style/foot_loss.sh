@@ -45,5 +45,17 @@ done
 require_fold_model
 measure first-w0 "$FOLD_MODEL" --held-out first
 measure first-w300 "$M-first-w300.safetensors" --held-out first
+# The shipped-fold models of seed 1 judged with the forest's seeds 2 and 3 too
+# (the judges' own spread; judges.sh does all judges, seeds and folds).
+for name in s1-w0 s1-w300; do
+  model=$M-$name.safetensors
+  [[ $name == s1-w0 ]] && model=models/style-default.safetensors
+  for seed in 2 3; do
+    "$BIN/style_eval" --model "$model" --seed "$seed" --methods elastic-patches \
+      --sources walk,walk-turn-left,walk-turn-right --styles walk --classifier-contents "$WALKS" \
+      --json "$F/eval-$name-judge$seed.json" --markdown "$F/eval-$name-judge$seed.md" \
+      "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  done
+done
 python3 bench/style/foot_loss_table.py "$F" > "$F/summary.md"
 cat "$F/summary.md"
