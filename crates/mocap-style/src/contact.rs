@@ -251,6 +251,31 @@ pub(crate) fn heights_above_ground(poses: &GlobalPoses, joint: usize, up: Vec3) 
     heights.into_iter().map(|h| h - ground).collect()
 }
 
+/// Per foot (left, right) and frame step `f - 1 -> f` (entry `f - 1`):
+/// whether the foot is flat on the ground at both frames, that is every
+/// joint of it (ankle and toe) within 2% of the leg length of its lowest
+/// height. A real take's flat feet stand still; the evaluation measures how
+/// much an output's slide (`eval::planted_foot_sliding`), and the
+/// autoencoder's loss on the feet keeps them still ([`crate::foot_loss`]).
+pub(crate) fn flat_foot_steps(
+    poses: &GlobalPoses,
+    rig: &RigLayout,
+    up: Vec3,
+    leg: f32,
+) -> [Vec<bool>; 2] {
+    let tolerance = 0.02 * leg;
+    [&rig.left_foot, &rig.right_foot].map(|foot| {
+        let heights: Vec<Vec<f32>> = foot
+            .iter()
+            .map(|&j| heights_above_ground(poses, j, up))
+            .collect();
+        let flat = |f: usize| heights.iter().all(|h| h[f] <= tolerance);
+        (1..poses.frame_count)
+            .map(|f| flat(f) && flat(f - 1))
+            .collect()
+    })
+}
+
 /// Settings of [`root_from_feet`]. Lengths are fractions of the leg length,
 /// so they hold for any rig and unit.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -39,7 +39,7 @@ use crate::apply::{
 };
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
-use crate::contact::{heights_above_ground, travelled};
+use crate::contact::{flat_foot_steps, heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake};
 use crate::features::{up_axis, RigLayout};
@@ -399,23 +399,12 @@ pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
 pub fn planted_foot_sliding(motion: &Motion, rig: &RigLayout) -> f64 {
     let poses = forward_kinematics(motion);
     let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let n = poses.frame_count;
-    let tolerance = 0.02 * rig.leg_length(motion.skeleton());
+    let flat = flat_foot_steps(&poses, rig, up, rig.leg_length(motion.skeleton()));
     let fps = motion.fps() as f32;
     let mut sum = 0.0f64;
     let mut count = 0usize;
-    for foot in [&rig.left_foot, &rig.right_foot] {
-        let heights: Vec<Vec<f32>> = foot
-            .iter()
-            .map(|&j| heights_above_ground(&poses, j, up))
-            .collect();
-        for f in 1..n {
-            if !heights
-                .iter()
-                .all(|h| h[f] <= tolerance && h[f - 1] <= tolerance)
-            {
-                continue;
-            }
+    for (foot, steps) in [&rig.left_foot, &rig.right_foot].into_iter().zip(&flat) {
+        for f in (1..poses.frame_count).filter(|&f| steps[f - 1]) {
             let slowest = foot
                 .iter()
                 .map(|&j| {
@@ -814,6 +803,26 @@ fn evaluate_set(
         let source_distance = travelled(&source.motion, rig);
         // Encoded once for all its pairs; each pair's timings include it.
         let prepared_source = prepare_source(model, &source.motion, options.convert.asymmetry)?;
+        // The source as it is, scored once; each pair's "source unchanged"
+        // row takes the style clip's name and period.
+        let unchanged = PairResult {
+            source: source.name.clone(),
+            style_clip: String::new(),
+            method: Method::ElasticPatches,
+            predicted_style: style_classifier.predict(&source.motion)?,
+            predicted_content: content_classifier.predict(&source.motion)?,
+            period_output: periods[&source.name],
+            period_style: None,
+            period_source: periods[&source.name],
+            foot_skating: foot_skating(&source.motion, rig),
+            planted_foot_sliding: planted_foot_sliding(&source.motion, rig),
+            foot_reach: largest_foot_reach(&source.motion, rig),
+            jitter: motion_jitter(&source.motion),
+            time_scale: 1.0,
+            distance_ratio: 1.0,
+            root_shift: 0.0,
+            timings: StageTimings::default(),
+        };
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
                 continue;
@@ -852,22 +861,9 @@ fn evaluate_set(
             }
             // The source left unchanged, scored against the style clip.
             source_rows.push(PairResult {
-                source: source.name.clone(),
                 style_clip: style.name.clone(),
-                method: Method::ElasticPatches,
-                predicted_style: style_classifier.predict(&source.motion)?,
-                predicted_content: content_classifier.predict(&source.motion)?,
-                period_output: periods[&source.name],
                 period_style: periods[&style.name],
-                period_source: periods[&source.name],
-                foot_skating: foot_skating(&source.motion, rig),
-                planted_foot_sliding: planted_foot_sliding(&source.motion, rig),
-                foot_reach: largest_foot_reach(&source.motion, rig),
-                jitter: motion_jitter(&source.motion),
-                time_scale: 1.0,
-                distance_ratio: 1.0,
-                root_shift: 0.0,
-                timings: StageTimings::default(),
+                ..unchanged.clone()
             });
         }
         bar.inc(1);

@@ -35,7 +35,7 @@ use mocap_core::rotation::{Mat3, Quat};
 use mocap_core::{forward_kinematics, Motion, Skeleton};
 use mocap_nn::kinematics::{child_position, compose, Columns};
 
-use crate::contact::heights_above_ground;
+use crate::contact;
 use crate::features::{up_axis, Normalization, RigLayout, SLOT_DIM};
 
 /// Forward kinematics of the feet, from standardised features.
@@ -192,25 +192,11 @@ fn exp_columns(v: &[Tensor<3>; 3]) -> Columns {
 pub fn flat_foot_steps(motion: &Motion, rig: &RigLayout) -> Vec<f32> {
     let poses = forward_kinematics(motion);
     let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let n = poses.frame_count;
-    let tolerance = 0.02 * rig.leg_length(motion.skeleton());
-    let flat: Vec<Vec<bool>> = [&rig.left_foot, &rig.right_foot]
-        .iter()
-        .map(|foot| {
-            let heights: Vec<Vec<f32>> = foot
-                .iter()
-                .map(|&j| heights_above_ground(&poses, j, up))
-                .collect();
-            (0..n)
-                .map(|f| heights.iter().all(|h| h[f] <= tolerance))
-                .collect()
-        })
-        .collect();
+    let flat = contact::flat_foot_steps(&poses, rig, up, rig.leg_length(motion.skeleton()));
     let mut out = Vec::new();
-    for f in 1..n {
-        for (side, foot) in [&rig.left_foot, &rig.right_foot].iter().enumerate() {
-            let on = (flat[side][f] && flat[side][f - 1]) as u8 as f32;
-            out.extend(std::iter::repeat_n(on, foot.len()));
+    for step in 0..poses.frame_count.saturating_sub(1) {
+        for (steps, foot) in flat.iter().zip([&rig.left_foot, &rig.right_foot]) {
+            out.extend(std::iter::repeat_n(steps[step] as u8 as f32, foot.len()));
         }
     }
     out
