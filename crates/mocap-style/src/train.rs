@@ -268,7 +268,8 @@ fn from_tensor(tensor: Tensor<3>, frames: usize) -> Result<Latents> {
 struct FeatureClip {
     frames: usize,
     features: Vec<f32>,
-    /// [`crate::foot_loss::flat_foot_steps`] of the clip.
+    /// [`crate::foot_loss::flat_foot_steps`] of the clip (empty without a
+    /// loss on the feet).
     contacts: Vec<f32>,
 }
 
@@ -333,9 +334,12 @@ impl<'a> WindowSampler<'a> {
                     x[(b * c + ch) * frames + f] = clip.features[(start + f) * c + ch];
                 }
             }
-            // Step k of the clip goes from frame k to k + 1.
-            let steps = frames.saturating_sub(1) * self.feet;
-            contacts.extend_from_slice(&clip.contacts[start * self.feet..][..steps]);
+            // Step k of the clip goes from frame k to k + 1 (none are kept
+            // without a loss on the feet).
+            if !clip.contacts.is_empty() {
+                let steps = frames.saturating_sub(1) * self.feet;
+                contacts.extend_from_slice(&clip.contacts[start * self.feet..][..steps]);
+            }
         }
         (x, frames, contacts)
     }
@@ -399,7 +403,14 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 motions.push(mirrored(&motion)?);
             }
             for m in motions {
-                out.push((decompose(&m, &rig).0, flat_foot_steps(&m, &rig)));
+                // Contact steps only for the loss on the feet: finding them
+                // runs forward kinematics over every clip.
+                let contacts = if options.foot_loss_weight > 0.0 {
+                    flat_foot_steps(&m, &rig)
+                } else {
+                    Vec::new()
+                };
+                out.push((decompose(&m, &rig).0, contacts));
             }
         }
         Ok(out)
