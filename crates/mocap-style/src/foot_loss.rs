@@ -114,15 +114,29 @@ impl FootKinematics {
                 )
             })
         };
-        let pelvis = slot(0);
+        // Each slot's rotation once: an ankle's and a toe's chains share the
+        // hip, knee and ankle. The last joint of a chain needs no rotation.
+        let mut locals: Vec<Option<Columns>> = (0..self.reference.len()).map(|_| None).collect();
+        locals[0] = Some(slot(0));
+        for chain in &self.chains {
+            for (slot_index, _) in &chain[..chain.len().saturating_sub(1)] {
+                if let Some(k) = *slot_index {
+                    if locals[k].is_none() {
+                        locals[k] = Some(slot(k));
+                    }
+                }
+            }
+        }
+        let local = |k: usize| locals[k].as_ref().expect("computed above");
         let mut out = Vec::with_capacity(self.chains.len());
         for chain in &self.chains {
-            let mut rotation = pelvis.clone();
+            let mut rotation = local(0).clone();
             let mut position = Tensor::<3>::zeros([batch, 3, frames], &device);
-            for (slot_index, offset) in chain {
+            let last = chain.len().saturating_sub(1);
+            for (i, (slot_index, offset)) in chain.iter().enumerate() {
                 position = child_position(position, &rotation, *offset);
-                if let Some(k) = slot_index {
-                    rotation = compose(&rotation, &slot(*k));
+                if let (Some(k), true) = (slot_index, i < last) {
+                    rotation = compose(&rotation, local(*k));
                 }
             }
             out.push(position / self.leg);
