@@ -28,6 +28,10 @@ if flag --train; then
   cp models/style-default.png bench/style/loss.png
   # The loss plot goes to bench/style; the resumable state is not shipped.
   rm -rf models/style-default.png models/style-default.state
+  # The examples carry the default model inside them (include_bytes!), so
+  # they are built again: without this the evaluation below would judge
+  # the model that was shipped before.
+  cargo build -q --profile test -p mocap-style --examples
 fi
 
 if flag --classifiers; then
