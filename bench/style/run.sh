@@ -22,8 +22,9 @@ flag() { [[ "$ARGS" == *" $1 "* ]]; }
 if flag --train; then
   # The shipped default: the report's setting (240-frame windows, batch 16,
   # Adam, lr 1e-4), walking takes of both sets without the held-out takes,
-  # with mirrored copies, seed 1.
-  "$BIN/style_train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
+  # with mirrored copies, seed 1, and the loss on the planted feet at weight
+  # 300 (session 19; style.md, "A loss on the feet").
+  "$BIN/style_train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" --foot-loss 300 \
     -o models/style-default.safetensors "$DATA/dataset-1" "$DATA/dataset-2" > "$OUT/train.json"
   cp models/style-default.png bench/style/loss.png
   # The loss plot goes to bench/style; the resumable state is not shipped.
@@ -108,7 +109,7 @@ if flag --other-fold; then
   FOLD=$OUT/fold-first
   mkdir -p "$FOLD"
   "$BIN/style_train" --held-out first --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
-    -o "$FOLD_MODEL" "$DATA/dataset-1" "$DATA/dataset-2" > "$FOLD/train.json"
+    --foot-loss 300 -o "$FOLD_MODEL" "$DATA/dataset-1" "$DATA/dataset-2" > "$FOLD/train.json"
   "$BIN/style_eval" --held-out first --model "$FOLD_MODEL" \
     --sources walk,walk-turn-left,walk-turn-right --styles walk \
     --classifier-contents "$WALKS" --json "$FOLD/eval.json" --markdown "$FOLD/eval.md" \
