@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release -p mocap-style --example style_train -- \
-//!     [--epochs 30] [--steps 100] [--contents walk,walk-back] [--seed 1] [--foot-loss W] [--equal-sets] \
+//!     [--epochs 30] [--steps 100] [--contents walk,walk-back] [--seed 1] [--foot-loss W] \
 //!     -o models/style-default.safetensors DIR...
 //! ```
 
@@ -28,7 +28,6 @@ fn main() {
             "--held-out" => options.held_out_take = value().parse().expect("--held-out last|first"),
             "--resume" => options.resume = true,
             "--foot-loss" => options.foot_loss_weight = value().parse().expect("--foot-loss W"),
-            "--equal-sets" => options.equal_sets = true,
             _ => options.inputs.push(PathBuf::from(a)),
         }
     }

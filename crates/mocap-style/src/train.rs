@@ -15,7 +15,6 @@
 //! of epoch `e` come from a generator seeded with `(seed, e)`, so a resumed
 //! run draws the windows an uninterrupted one would.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -97,11 +96,6 @@ pub struct TrainOptions {
     /// reconstruction error; 0: the report's loss alone.
     #[serde(default)]
     pub foot_loss_weight: f64,
-    /// Draw training windows so that every set (the `<set>` of the clips'
-    /// names, e.g. `dataset-1`) gets the same share of them, whatever its
-    /// number of frames; default false: each frame equally likely.
-    #[serde(default)]
-    pub equal_sets: bool,
 }
 
 impl Default for TrainOptions {
@@ -126,7 +120,6 @@ impl Default for TrainOptions {
             resume: false,
             network: AutoencoderConfig::report(0),
             foot_loss_weight: 0.0,
-            equal_sets: false,
         }
     }
 }
@@ -273,8 +266,6 @@ fn from_tensor(tensor: Tensor<3>, frames: usize) -> Result<Latents> {
 
 /// A training clip: standardised features, frame after frame.
 struct FeatureClip {
-    /// The set of the clip's name ([`crate::data::Labels::set`]).
-    set: String,
     frames: usize,
     features: Vec<f32>,
     /// [`crate::foot_loss::flat_foot_steps`] of the clip (empty without a
@@ -286,9 +277,6 @@ struct FeatureClip {
 struct WindowSampler<'a> {
     clips: &'a [FeatureClip],
     cumulative: Vec<usize>,
-    /// With equal sets: cumulative probability of each clip (each set's
-    /// clips share 1 / sets, by their frames).
-    cumulative_equal_sets: Option<Vec<f64>>,
     channels: usize,
     window: usize,
     /// Foot joints per contact step.
@@ -301,7 +289,6 @@ impl<'a> WindowSampler<'a> {
         channels: usize,
         window: usize,
         feet: usize,
-        equal_sets: bool,
     ) -> WindowSampler<'a> {
         let mut total = 0;
         let cumulative = clips
@@ -311,53 +298,25 @@ impl<'a> WindowSampler<'a> {
                 total
             })
             .collect();
-        let cumulative_equal_sets = equal_sets.then(|| {
-            let mut set_frames: BTreeMap<&str, usize> = BTreeMap::new();
-            for c in clips {
-                *set_frames.entry(&c.set).or_default() += c.frames;
-            }
-            let sets = set_frames.len() as f64;
-            let mut sum = 0.0;
-            clips
-                .iter()
-                .map(|c| {
-                    sum += c.frames as f64 / set_frames[c.set.as_str()] as f64 / sets;
-                    sum
-                })
-                .collect()
-        });
         WindowSampler {
             clips,
             cumulative,
-            cumulative_equal_sets,
             channels,
             window,
             feet,
         }
     }
 
-    /// The index of a clip drawn at random: by its frames, or with equal
-    /// sets by its frames within its set.
-    fn pick(&self, rng: &mut ChaCha8Rng) -> usize {
-        match &self.cumulative_equal_sets {
-            None => {
-                let total = *self.cumulative.last().expect("training clips");
-                let u = rng.random_range(0..total);
-                self.cumulative.partition_point(|&c| c <= u)
-            }
-            Some(cumulative) => {
-                let u = rng.random_range(0.0..*cumulative.last().expect("training clips"));
-                cumulative
-                    .partition_point(|&c| c <= u)
-                    .min(self.clips.len() - 1)
-            }
-        }
-    }
-
     /// A batch `[size, channels, frames]`, its frame count, and the contact
     /// steps of its windows (`frames - 1` steps of `feet` values each).
     fn batch(&self, rng: &mut ChaCha8Rng, size: usize) -> (Vec<f32>, usize, Vec<f32>) {
-        let picked: Vec<usize> = (0..size).map(|_| self.pick(rng)).collect();
+        let total = *self.cumulative.last().expect("training clips");
+        let picked: Vec<usize> = (0..size)
+            .map(|_| {
+                let u = rng.random_range(0..total);
+                self.cumulative.partition_point(|&c| c <= u)
+            })
+            .collect();
         let frames = picked
             .iter()
             .map(|&i| self.clips[i].frames)
@@ -430,12 +389,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
 
     // Slot rotations of every clip (and mirror), at the first clip's rate,
     // with the frame steps where its feet are flat on the ground.
-    struct ClipRotations {
-        set: String,
-        rotations: Vec<Quat>,
-        contacts: Vec<f32>,
-    }
-    let rotations_of = |clips: &[crate::data::Clip]| -> Result<Vec<ClipRotations>> {
+    let rotations_of = |clips: &[crate::data::Clip]| -> Result<Vec<(Vec<Quat>, Vec<f32>)>> {
         let mut out = Vec::new();
         for clip in clips {
             rig.check_skeleton(clip.motion.skeleton(), &clip.path.display().to_string())?;
@@ -456,11 +410,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 } else {
                     Vec::new()
                 };
-                out.push(ClipRotations {
-                    set: clip.labels.set.clone(),
-                    rotations: decompose(&m, &rig).0,
-                    contacts,
-                });
+                out.push((decompose(&m, &rig).0, contacts));
             }
         }
         Ok(out)
@@ -471,18 +421,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let normalization = Normalization::fit(
         &train_rotations
             .iter()
-            .map(|c| c.rotations.as_slice())
+            .map(|(r, _)| r.as_slice())
             .collect::<Vec<_>>(),
         slots,
     )?;
-    let to_features = |clips: &[ClipRotations]| -> Vec<FeatureClip> {
-        clips
+    let to_features = |rotations: &[(Vec<Quat>, Vec<f32>)]| -> Vec<FeatureClip> {
+        rotations
             .iter()
-            .map(|c| FeatureClip {
-                set: c.set.clone(),
-                frames: c.rotations.len() / slots,
-                features: normalization.features(&c.rotations),
-                contacts: c.contacts.clone(),
+            .map(|(r, contacts)| FeatureClip {
+                frames: r.len() / slots,
+                features: normalization.features(r),
+                contacts: contacts.clone(),
             })
             .collect()
     };
@@ -542,7 +491,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         training: serde_json::json!({
             "loss": if options.foot_loss_weight > 0.0 { "mse + feet" } else { "mse" },
             "foot_loss_weight": options.foot_loss_weight,
-            "equal_sets": options.equal_sets,
             "epochs": history.epochs.len(),
             "steps_per_epoch": options.steps_per_epoch,
             "batch_size": options.batch_size,
@@ -565,7 +513,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         network.channels,
         options.window,
         feet.feet(),
-        options.equal_sets,
     );
     struct Run {
         model: Option<StyleAutoencoder>,
@@ -688,44 +635,5 @@ fn validation_mse(
         f64::NAN
     } else {
         sum / count as f64
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn clip(set: &str, frames: usize) -> FeatureClip {
-        FeatureClip {
-            set: set.to_string(),
-            frames,
-            features: vec![0.0; frames],
-            contacts: Vec::new(),
-        }
-    }
-
-    /// Share of 8000 drawn clips that come from set `a`, which holds a
-    /// quarter of the frames (in clips of two lengths).
-    fn share_of_a(equal_sets: bool) -> f64 {
-        let clips = [
-            clip("a", 100),
-            clip("a", 300),
-            clip("b", 600),
-            clip("b", 600),
-        ];
-        let sampler = WindowSampler::new(&clips, 1, 50, 0, equal_sets);
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let from_a = (0..8000)
-            .filter(|_| clips[sampler.pick(&mut rng)].set == "a")
-            .count();
-        from_a as f64 / 8000.0
-    }
-
-    #[test]
-    fn equal_sets_gives_each_set_the_same_share_of_windows() {
-        let by_frames = share_of_a(false);
-        let equal = share_of_a(true);
-        assert!((by_frames - 0.25).abs() < 0.02, "by frames: {by_frames}");
-        assert!((equal - 0.5).abs() < 0.02, "equal sets: {equal}");
     }
 }
