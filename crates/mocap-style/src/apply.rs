@@ -245,9 +245,9 @@ pub fn source_reconstruction_deg(model: &StyleModel, source: &Motion) -> Result<
 /// motion the shipped model was trained on, and its content is likely lost.
 /// Measured with the shipped model on every Bandai clip (`familiarity`
 /// example; bench/results/style.md, "Sources the model cannot
-/// reproduce"): above 7 degrees lie 2.7% of the clips of the walking
-/// contents it was trained on and 93.7% of the others (gestures, runs,
-/// kicks...).
+/// reproduce"): above 7 degrees lie 2.4% of the clips of the walking
+/// contents it was trained on and 94.0% of the others (gestures, runs,
+/// kicks...; session 18's model: 2.7% and 93.7%).
 pub const UNFAMILIAR_SOURCE_DEG: f32 = 7.0;
 
 /// [`ApplyReport::model`] when the shipped model restyled.
