@@ -27,8 +27,6 @@
 
 use std::path::PathBuf;
 
-use mocap_core::forward_kinematics;
-use mocap_core::metrics::jitter;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{
@@ -39,7 +37,7 @@ use mocap_style::convert::ConvertOptions;
 use mocap_style::data::{
     held_out, labelled_paths, list_bvh, load_clips, ClipFilter, HeldOutTake, WALKING_CONTENTS,
 };
-use mocap_style::eval::{foot_skating, largest_foot_reach, planted_foot_sliding};
+use mocap_style::eval::{largest_foot_reach, planted_foot_sliding, MotionMeasures};
 use mocap_style::features::RigLayout;
 
 const SOURCES: [&str; 3] = ["walk", "walk-turn-left", "walk-turn-right"];
@@ -56,11 +54,12 @@ struct Tally {
 
 impl Tally {
     fn add(&mut self, motion: &Motion, rig: &RigLayout, real_reach: f64, max_shift: f32) {
-        self.skating += foot_skating(motion, rig);
-        self.sliding += planted_foot_sliding(motion, rig);
-        self.beyond += (largest_foot_reach(motion, rig) > real_reach) as usize;
+        let measures = MotionMeasures::of(motion, rig);
+        self.skating += measures.foot_skating;
+        self.sliding += measures.planted_foot_sliding;
+        self.beyond += (measures.foot_reach > real_reach) as usize;
         self.max_shift = self.max_shift.max(max_shift);
-        self.jitter += jitter(&forward_kinematics(motion), None).expect("jitter") as f64;
+        self.jitter += measures.jitter;
         self.outputs += 1;
     }
 }

@@ -127,7 +127,7 @@ pub fn clean_foot_contacts(
         let leg = rig.leg_length(motion.skeleton());
         let tolerance = options.height_tolerance * leg;
         let heights = heights_above_ground(&poses, ankle, up);
-        let horizontal = |p: Vec3| p - up * p.dot(up);
+        let horizontal = |p: Vec3| p.reject_from_normalized(up);
         // Below this speed relative to the pelvis (0.1 leg lengths per
         // second) a foot counts as still: a standing body has no travel to
         // tell a swing by.
@@ -359,7 +359,7 @@ pub fn root_from_feet(
         return RootShift::default();
     }
     let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let horizontal = |p: Vec3| p - up * p.dot(up);
+    let horizontal = |p: Vec3| p.reject_from_normalized(up);
     let leg = rig.leg_length(motion.skeleton()).max(1e-6);
     let tolerance = options.height_tolerance * leg;
     let height_scale = (options.height_scale * leg).max(1e-6);
@@ -509,7 +509,7 @@ pub fn travelled(motion: &Motion, rig: &RigLayout) -> f32 {
     (1..poses.frame_count)
         .map(|f| {
             let d = poses.position(f, rig.pelvis) - poses.position(f - 1, rig.pelvis);
-            (d - up * d.dot(up)).length()
+            d.reject_from_normalized(up).length()
         })
         .sum()
 }

@@ -30,7 +30,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mocap_core::metrics::jitter;
-use mocap_core::{forward_kinematics, Motion};
+use mocap_core::rotation::Vec3;
+use mocap_core::{forward_kinematics, GlobalPoses, Motion};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -356,32 +357,7 @@ pub fn gait_period(motion: &Motion, rig: &RigLayout) -> Option<f64> {
 /// within 5% of the leg length above the joint's lowest height in the clip
 /// (its 2nd percentile, robust to a stray frame).
 pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
-    let poses = forward_kinematics(motion);
-    let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let n = poses.frame_count;
-    if n < 2 {
-        return 0.0;
-    }
-    let tolerance = 0.05 * rig.leg_length(motion.skeleton());
-    let fps = motion.fps() as f32;
-    let mut sum = 0.0f64;
-    let mut count = 0usize;
-    for &j in rig.left_foot.iter().chain(&rig.right_foot) {
-        let h = heights_above_ground(&poses, j, up);
-        for f in 1..n {
-            if h[f] <= tolerance && h[f - 1] <= tolerance {
-                let d = poses.position(f, j) - poses.position(f - 1, j);
-                let horizontal = d - up * d.dot(up);
-                sum += (horizontal.length() * fps) as f64;
-                count += 1;
-            }
-        }
-    }
-    if count == 0 {
-        0.0
-    } else {
-        sum / count as f64
-    }
+    FootFrame::of(motion, rig).foot_skating(rig)
 }
 
 /// Sliding of the planted foot: the mean horizontal speed (file units per
@@ -397,30 +373,7 @@ pub fn foot_skating(motion: &Motion, rig: &RigLayout) -> f64 {
 /// 4.0 cm/s on dataset-1, 6.6 on dataset-2, over 43% and 38% of the feet's
 /// frames): its movement is what an animator sees as the foot sliding.
 pub fn planted_foot_sliding(motion: &Motion, rig: &RigLayout) -> f64 {
-    let poses = forward_kinematics(motion);
-    let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let flat = flat_foot_steps(&poses, rig, up, rig.leg_length(motion.skeleton()));
-    let fps = motion.fps() as f32;
-    let mut sum = 0.0f64;
-    let mut count = 0usize;
-    for (foot, steps) in [&rig.left_foot, &rig.right_foot].into_iter().zip(&flat) {
-        for f in (1..poses.frame_count).filter(|&f| steps[f - 1]) {
-            let slowest = foot
-                .iter()
-                .map(|&j| {
-                    let d = poses.position(f, j) - poses.position(f - 1, j);
-                    (d - up * d.dot(up)).length() * fps
-                })
-                .fold(f32::INFINITY, f32::min);
-            sum += slowest as f64;
-            count += 1;
-        }
-    }
-    if count == 0 {
-        0.0
-    } else {
-        sum / count as f64
-    }
+    FootFrame::of(motion, rig).planted_foot_sliding(rig)
 }
 
 /// How far a foot reaches out from under the body: the largest horizontal
@@ -429,21 +382,114 @@ pub fn planted_foot_sliding(motion: &Motion, rig: &RigLayout) -> f64 {
 /// foot-contact cleanup that holds an ankle where the leg cannot follow
 /// pulls it out to nearly a whole leg length, the leg stretched off the body.
 pub fn largest_foot_reach(motion: &Motion, rig: &RigLayout) -> f64 {
-    let poses = forward_kinematics(motion);
-    let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let leg = rig.leg_length(motion.skeleton()).max(1e-6);
-    let mut largest = 0.0f32;
-    for foot in [&rig.left_foot, &rig.right_foot] {
-        let ankle = foot[0];
-        let Some(hip) = rig.parents[ankle].and_then(|knee| rig.parents[knee]) else {
-            continue;
-        };
-        for f in 0..poses.frame_count {
-            let d = poses.position(f, ankle) - poses.position(f, hip);
-            largest = largest.max((d - up * d.dot(up)).length());
+    FootFrame::of(motion, rig).largest_foot_reach(rig)
+}
+
+/// What the foot measures of one motion share: its global poses (one
+/// forward kinematics pass), up axis, leg length and frame rate.
+struct FootFrame {
+    poses: GlobalPoses,
+    up: Vec3,
+    leg: f32,
+    fps: f32,
+}
+
+impl FootFrame {
+    fn of(motion: &Motion, rig: &RigLayout) -> FootFrame {
+        let poses = forward_kinematics(motion);
+        let up = up_axis(&poses.positions, poses.joint_count, rig);
+        FootFrame {
+            poses,
+            up,
+            leg: rig.leg_length(motion.skeleton()),
+            fps: motion.fps() as f32,
         }
     }
-    (largest / leg) as f64
+
+    /// Horizontal speed of `joint` from frame `f - 1` to `f`, units per second.
+    fn horizontal_speed(&self, f: usize, joint: usize) -> f32 {
+        let d = self.poses.position(f, joint) - self.poses.position(f - 1, joint);
+        d.reject_from_normalized(self.up).length() * self.fps
+    }
+
+    fn foot_skating(&self, rig: &RigLayout) -> f64 {
+        let tolerance = 0.05 * self.leg;
+        let mut speeds = Vec::new();
+        for &j in rig.left_foot.iter().chain(&rig.right_foot) {
+            let h = heights_above_ground(&self.poses, j, self.up);
+            for f in 1..self.poses.frame_count {
+                if h[f] <= tolerance && h[f - 1] <= tolerance {
+                    speeds.push(self.horizontal_speed(f, j));
+                }
+            }
+        }
+        mean_or_zero(&speeds)
+    }
+
+    fn planted_foot_sliding(&self, rig: &RigLayout) -> f64 {
+        let flat = flat_foot_steps(&self.poses, rig, self.up, self.leg);
+        let mut speeds = Vec::new();
+        for (foot, steps) in [&rig.left_foot, &rig.right_foot].into_iter().zip(&flat) {
+            for f in (1..self.poses.frame_count).filter(|&f| steps[f - 1]) {
+                let slowest = foot
+                    .iter()
+                    .map(|&j| self.horizontal_speed(f, j))
+                    .fold(f32::INFINITY, f32::min);
+                speeds.push(slowest);
+            }
+        }
+        mean_or_zero(&speeds)
+    }
+
+    fn largest_foot_reach(&self, rig: &RigLayout) -> f64 {
+        let mut largest = 0.0f32;
+        for foot in [&rig.left_foot, &rig.right_foot] {
+            let ankle = foot[0];
+            let Some(hip) = rig.parents[ankle].and_then(|knee| rig.parents[knee]) else {
+                continue;
+            };
+            for f in 0..self.poses.frame_count {
+                let d = self.poses.position(f, ankle) - self.poses.position(f, hip);
+                largest = largest.max(d.reject_from_normalized(self.up).length());
+            }
+        }
+        (largest / self.leg.max(1e-6)) as f64
+    }
+}
+
+/// The mean of `speeds` in f64 (0 for none).
+fn mean_or_zero(speeds: &[f32]) -> f64 {
+    if speeds.is_empty() {
+        0.0
+    } else {
+        speeds.iter().map(|&v| v as f64).sum::<f64>() / speeds.len() as f64
+    }
+}
+
+/// The evaluation's foot measures and jitter of one motion, from one
+/// forward kinematics pass.
+#[derive(Debug, Clone, Copy)]
+pub struct MotionMeasures {
+    /// [`foot_skating`], file units per second.
+    pub foot_skating: f64,
+    /// [`planted_foot_sliding`], file units per second.
+    pub planted_foot_sliding: f64,
+    /// [`largest_foot_reach`], leg lengths.
+    pub foot_reach: f64,
+    /// Mean jerk of all joints ([`mocap_core::metrics::jitter`]).
+    pub jitter: f64,
+}
+
+impl MotionMeasures {
+    pub fn of(motion: &Motion, rig: &RigLayout) -> MotionMeasures {
+        let frame = FootFrame::of(motion, rig);
+        MotionMeasures {
+            foot_skating: frame.foot_skating(rig),
+            planted_foot_sliding: frame.planted_foot_sliding(rig),
+            foot_reach: frame.largest_foot_reach(rig),
+            jitter: jitter(&frame.poses, None).map_or(f64::NAN, |v| v as f64),
+        }
+    }
 }
 
 /// Where the left and the right ankle's sideways offsets from the pelvis
@@ -469,11 +515,6 @@ pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
         .iter()
         .map(|&i| statistics[i] as f64)
         .sum())
-}
-
-/// Mean jerk of all joints (see [`mocap_core::metrics::jitter`]).
-fn motion_jitter(motion: &Motion) -> f64 {
-    jitter(&forward_kinematics(motion), None).map_or(f64::NAN, |v| v as f64)
 }
 
 /// Runs the evaluation (see the module docs).
@@ -805,6 +846,7 @@ fn evaluate_set(
         let prepared_source = prepare_source(model, &source.motion, options.convert.asymmetry)?;
         // The source as it is, scored once; each pair's "source unchanged"
         // row takes the style clip's name and period.
+        let measures = MotionMeasures::of(&source.motion, rig);
         let unchanged = PairResult {
             source: source.name.clone(),
             style_clip: String::new(),
@@ -814,10 +856,10 @@ fn evaluate_set(
             period_output: periods[&source.name],
             period_style: None,
             period_source: periods[&source.name],
-            foot_skating: foot_skating(&source.motion, rig),
-            planted_foot_sliding: planted_foot_sliding(&source.motion, rig),
-            foot_reach: largest_foot_reach(&source.motion, rig),
-            jitter: motion_jitter(&source.motion),
+            foot_skating: measures.foot_skating,
+            planted_foot_sliding: measures.planted_foot_sliding,
+            foot_reach: measures.foot_reach,
+            jitter: measures.jitter,
             time_scale: 1.0,
             distance_ratio: 1.0,
             root_shift: 0.0,
@@ -840,6 +882,7 @@ fn evaluate_set(
                     prepare_times[k],
                 )?;
                 let out = &restyled.motion;
+                let measures = MotionMeasures::of(out, rig);
                 pairs.push(PairResult {
                     source: source.name.clone(),
                     style_clip: style.name.clone(),
@@ -849,10 +892,10 @@ fn evaluate_set(
                     period_output: gait_period(out, rig),
                     period_style: periods[&style.name],
                     period_source: periods[&source.name],
-                    foot_skating: foot_skating(out, rig),
-                    planted_foot_sliding: planted_foot_sliding(out, rig),
-                    foot_reach: largest_foot_reach(out, rig),
-                    jitter: motion_jitter(out),
+                    foot_skating: measures.foot_skating,
+                    planted_foot_sliding: measures.planted_foot_sliding,
+                    foot_reach: measures.foot_reach,
+                    jitter: measures.jitter,
                     time_scale: out.duration() / source.motion.duration(),
                     distance_ratio: (travelled(out, rig) / source_distance) as f64,
                     root_shift: restyled.root_shift.mean as f64,
@@ -960,6 +1003,7 @@ fn evaluate_set(
     let style_rows: Vec<PairResult> = style_clips
         .iter()
         .map(|c| -> Result<PairResult> {
+            let measures = MotionMeasures::of(&c.motion, rig);
             Ok(PairResult {
                 source: c.name.clone(),
                 style_clip: c.name.clone(),
@@ -969,10 +1013,10 @@ fn evaluate_set(
                 period_output: periods[&c.name],
                 period_style: periods[&c.name],
                 period_source: periods[&c.name],
-                foot_skating: foot_skating(&c.motion, rig),
-                planted_foot_sliding: planted_foot_sliding(&c.motion, rig),
-                foot_reach: largest_foot_reach(&c.motion, rig),
-                jitter: motion_jitter(&c.motion),
+                foot_skating: measures.foot_skating,
+                planted_foot_sliding: measures.planted_foot_sliding,
+                foot_reach: measures.foot_reach,
+                jitter: measures.jitter,
                 time_scale: 1.0,
                 distance_ratio: 1.0,
                 root_shift: 0.0,
