@@ -4,8 +4,9 @@
 # shipped recipe and --foot-loss W (seeds 1 and 2, and the other fold), then
 # measures each: flat-foot sliding of the sources through the autoencoder
 # and of the outputs (example foot_cleanup) and the evaluation's judges
-# (style_eval). The seed-1 model with weight 0 is the shipped one. About an
-# hour on the 2-core machine (each training 6-9 min).
+# (style_eval). Since session 19 the shipped recipe has weight 300, so the
+# weight-0 models (the recipe before it) are trained here too. About 80
+# minutes on the 2-core machine (each training 6-9 min).
 #
 #   bash bench/style/foot_loss.sh                 # train, then measure
 #   bash bench/style/foot_loss.sh --measure-only  # measure models already trained
@@ -30,26 +31,25 @@ measure() { # NAME MODEL [extra options: --held-out first]
     --markdown "$F/eval-$name.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 }
 if [[ "${1:-}" != --measure-only ]]; then
+  train s1-w0 1 0
   train s1-w300 1 300
   train s1-w1000 1 1000
   train s2-w0 2 0
   train s2-w300 2 300
+  train first-w0 1 0 --held-out first
   train first-w300 1 300 --held-out first
 fi
-measure s1-w0 models/style-default.safetensors
-for name in s1-w300 s1-w1000 s2-w0 s2-w300; do
+for name in s1-w0 s1-w300 s1-w1000 s2-w0 s2-w300; do
   measure "$name" "$M-$name.safetensors"
 done
-# The other fold: the shipped recipe's model for it (run.sh --other-fold) and
-# the one with the loss on the feet.
-require_fold_model
-measure first-w0 "$FOLD_MODEL" --held-out first
-measure first-w300 "$M-first-w300.safetensors" --held-out first
+# The other fold, without and with the loss on the feet.
+for name in first-w0 first-w300; do
+  measure "$name" "$M-$name.safetensors" --held-out first
+done
 # The shipped-fold models of seed 1 judged with the forest's seeds 2 and 3 too
 # (the judges' own spread; judges.sh does all judges, seeds and folds).
 for name in s1-w0 s1-w300; do
   model=$M-$name.safetensors
-  [[ $name == s1-w0 ]] && model=models/style-default.safetensors
   for seed in 2 3; do
     "$BIN/style_eval" --model "$model" --seed "$seed" --methods elastic-patches \
       --sources walk,walk-turn-left,walk-turn-right --styles walk --classifier-contents "$WALKS" \

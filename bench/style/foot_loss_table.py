@@ -1,8 +1,9 @@
 """Summary table of bench/style/foot_loss.sh: one row per model.
 
 Reads, in the folder given, feet-NAME.md (example foot_cleanup) and
-eval-NAME.json (style_eval), and train-NAME.json where there is one (the
-shipped model's and the other fold's recipe models were trained by run.sh).
+eval-NAME.json (style_eval), and train-NAME.json where there is one (in
+session 18 the weight-0 models were run.sh's; their reports were copied
+there in session 19, when foot_loss.sh began to train them too).
 """
 import json
 import sys
@@ -11,12 +12,12 @@ from pathlib import Path
 from reports import method_row
 
 MODELS = [
-    ("s1-w0", "seed 1, weight 0 (shipped)", "bench/style/out/train.json"),
+    ("s1-w0", "seed 1, weight 0 (shipped until session 18)", None),
     ("s1-w300", "seed 1, weight 300", None),
     ("s1-w1000", "seed 1, weight 1000", None),
     ("s2-w0", "seed 2, weight 0", None),
     ("s2-w300", "seed 2, weight 300", None),
-    ("first-w0", "other fold, weight 0 (run.sh --other-fold)", "bench/style/out/fold-first/train.json"),
+    ("first-w0", "other fold, weight 0", None),
     ("first-w300", "other fold, weight 300", None),
 ]
 

@@ -241,6 +241,7 @@ mod tests {
     use super::*;
     use crate::data::test_support::bandai_walk;
     use crate::features::decompose;
+    use crate::train::to_tensor;
 
     /// The tensor forward kinematics gives the feet where the core's does
     /// (relative to the pelvis, heading removed), on a real walk.
@@ -253,16 +254,8 @@ mod tests {
         let (rotations, root) = decompose(&motion, &rig);
         let normalization = Normalization::fit(&[&rotations], rig.slots()).unwrap();
         let features = normalization.features(&rotations);
-        let channels = rig.channels();
         let frames = motion.frame_count();
-        let mut x = vec![0.0; features.len()];
-        for f in 0..frames {
-            for c in 0..channels {
-                x[c * frames + f] = features[f * channels + c];
-            }
-        }
-        let device = Device::flex();
-        let x = Tensor::<3>::from_data(TensorData::new(x, [1, channels, frames]), &device);
+        let x = to_tensor(&features, frames, rig.channels(), &Device::flex());
         let fk = FootKinematics::new(motion.skeleton(), &rig, &normalization);
         let out: Vec<f32> = fk.positions(x).into_data().try_to_vec().unwrap();
         let poses = forward_kinematics(&motion);
@@ -296,13 +289,10 @@ mod tests {
         let (channels, frames) = (rig.channels(), motion.frame_count());
         let device = Device::flex();
         let tensor = |shift: &dyn Fn(usize, usize) -> f32| {
-            let mut x = vec![0.0; features.len()];
-            for f in 0..frames {
-                for c in 0..channels {
-                    x[c * frames + f] = features[f * channels + c] + shift(f, c);
-                }
-            }
-            Tensor::<3>::from_data(TensorData::new(x, [1, channels, frames]), &device)
+            let shifted: Vec<f32> = (0..features.len())
+                .map(|i| features[i] + shift(i / channels, i % channels))
+                .collect();
+            to_tensor(&shifted, frames, channels, &device)
         };
         let fk = FootKinematics::new(motion.skeleton(), &rig, &normalization);
         let steps = flat_foot_steps(&motion, &rig);

@@ -238,7 +238,12 @@ impl StyleModel {
 }
 
 /// `[1, channels, frames]` tensor of frame-major values.
-fn to_tensor(values: &[f32], frames: usize, channels: usize, device: &Device) -> Tensor<3> {
+pub(crate) fn to_tensor(
+    values: &[f32],
+    frames: usize,
+    channels: usize,
+    device: &Device,
+) -> Tensor<3> {
     let mut t = vec![0.0; values.len()];
     for f in 0..frames {
         for c in 0..channels {
