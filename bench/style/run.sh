@@ -6,13 +6,12 @@
 #   bash bench/style/run.sh --train    # retrain models/style-default.safetensors first
 #   bash bench/style/run.sh --classifiers  # also compare the evaluation's classifiers
 #                                          # on real clips (held out + cross-validation)
-#   bash bench/style/run.sh --patches  # also the patch-length sensitivity (P = 16, 24, 48)
 #   bash bench/style/run.sh --contacts # also the foot-contact cleanup (example foot_cleanup,
 #                                      # and patches with it) and the root carried by the
 #                                      # feet everywhere (both opt-in)
 #   bash bench/style/run.sh --other-fold  # also the whole evaluation on the other fold:
 #                                      # the first take of each group held out (~10 min)
-# (flags combine)
+# (flags combine). The patch length: bench/style/patch_select.sh (after --other-fold).
 #
 source "$(dirname "$0")/setup.sh"
 
@@ -63,16 +62,6 @@ fi
 
 "$BIN/style_speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
   "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 | tee "$OUT/speed.md"
-
-if flag --patches; then
-  # Sensitivity to the patch length (the default, 32, is the main run),
-  # measured with the source's root (session 7).
-  for P in 16 24 48; do
-    "$BIN/style_eval" --root source --patch "$P" --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
-      --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-p$P.json" \
-      --markdown "$OUT/eval-p$P.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
-  done
-fi
 
 if flag --contacts; then
   # The foot-contact cleanup before and after session 18, how much the feet
