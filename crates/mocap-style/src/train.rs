@@ -96,11 +96,6 @@ pub struct TrainOptions {
     /// reconstruction error; 0: the report's loss alone.
     #[serde(default)]
     pub foot_loss_weight: f64,
-    /// Speeds at which every training clip (and mirror) is also played, by
-    /// resampling it in time (e.g. 0.85 and 1.15); empty: each clip as
-    /// captured. The validation clips are never resampled.
-    #[serde(default)]
-    pub time_scales: Vec<f64>,
 }
 
 impl Default for TrainOptions {
@@ -125,7 +120,6 @@ impl Default for TrainOptions {
             resume: false,
             network: AutoencoderConfig::report(0),
             foot_loss_weight: 0.0,
-            time_scales: Vec::new(),
         }
     }
 }
@@ -140,11 +134,8 @@ pub struct DataDescription {
     pub validation_takes: Vec<String>,
     /// Held-out evaluation takes left out.
     pub held_out_takes: usize,
-    /// Frames of training clips (mirrors and resampled copies included).
+    /// Frames of training clips (mirrors included).
     pub train_frames: usize,
-    /// [`TrainOptions::time_scales`].
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub time_scales: Vec<f64>,
 }
 
 /// What `mocap style train` reports.
@@ -403,51 +394,34 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
 
     // Slot rotations of every clip (and mirror), at the first clip's rate,
     // with the frame steps where its feet are flat on the ground.
-    let rotations_of =
-        |clips: &[crate::data::Clip], speeds: &[f64]| -> Result<Vec<(Vec<Quat>, Vec<f32>)>> {
-            let mut out = Vec::new();
-            for clip in clips {
-                rig.check_skeleton(clip.motion.skeleton(), &clip.path.display().to_string())?;
-                let motion = if (clip.motion.fps() - fps).abs() > 1e-3 * fps {
-                    resample_fps(&clip.motion, fps)?
-                } else {
-                    clip.motion.clone()
-                };
-                let mut motions = vec![motion.clone()];
-                if options.mirror {
-                    motions.push(mirrored(&motion)?);
-                }
-                // A clip played at speed s: resampled to fps / s, its frames
-                // then read at fps (s < 1 gives more frames: slower).
-                let mut played = Vec::new();
-                for m in &motions {
-                    for &speed in speeds {
-                        played.push(resample_fps(m, fps / speed)?);
-                    }
-                }
-                motions.extend(played);
-                for m in motions {
-                    // Contact steps only for the loss on the feet: finding them
-                    // runs forward kinematics over every clip.
-                    let contacts = if options.foot_loss_weight > 0.0 {
-                        flat_foot_steps(&m, &rig)
-                    } else {
-                        Vec::new()
-                    };
-                    out.push((decompose(&m, &rig).0, contacts));
-                }
+    let rotations_of = |clips: &[crate::data::Clip]| -> Result<Vec<(Vec<Quat>, Vec<f32>)>> {
+        let mut out = Vec::new();
+        for clip in clips {
+            rig.check_skeleton(clip.motion.skeleton(), &clip.path.display().to_string())?;
+            let motion = if (clip.motion.fps() - fps).abs() > 1e-3 * fps {
+                resample_fps(&clip.motion, fps)?
+            } else {
+                clip.motion.clone()
+            };
+            let mut motions = vec![motion.clone()];
+            if options.mirror {
+                motions.push(mirrored(&motion)?);
             }
-            Ok(out)
-        };
-    if options
-        .time_scales
-        .iter()
-        .any(|s| !(s.is_finite() && *s > 0.0))
-    {
-        return Err(invalid("time scales must be positive numbers"));
-    }
-    let train_rotations = rotations_of(&train_clips, &options.time_scales)?;
-    let valid_rotations = rotations_of(&valid_clips, &[])?;
+            for m in motions {
+                // Contact steps only for the loss on the feet: finding them
+                // runs forward kinematics over every clip.
+                let contacts = if options.foot_loss_weight > 0.0 {
+                    flat_foot_steps(&m, &rig)
+                } else {
+                    Vec::new()
+                };
+                out.push((decompose(&m, &rig).0, contacts));
+            }
+        }
+        Ok(out)
+    };
+    let train_rotations = rotations_of(&train_clips)?;
+    let valid_rotations = rotations_of(&valid_clips)?;
     let slots = rig.slots();
     let normalization = Normalization::fit(
         &train_rotations
@@ -489,7 +463,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         validation_takes: valid_clips.iter().map(|c| c.name.clone()).collect(),
         held_out_takes: held.len(),
         train_frames: train_features.iter().map(|c| c.frames).sum(),
-        time_scales: options.time_scales.clone(),
     };
 
     let device = options.device.training_device()?;
