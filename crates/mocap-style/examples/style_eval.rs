@@ -40,7 +40,6 @@ fn main() {
                     .expect("--asymmetry source|source-clip|style")
             }
             "--patch" => options.convert.patch = value().parse().expect("--patch N"),
-            "--style-pace" => options.convert.style_pace = true,
             "--style-descriptor" => {
                 options.style_descriptor = serde_json::from_value(serde_json::json!(value()))
                     .expect("intervals or statistics")

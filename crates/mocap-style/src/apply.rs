@@ -171,66 +171,6 @@ pub struct StyleClip {
     pub sequences: Vec<(Latents, Vec<f32>)>,
     /// Rest leg length of the style performer (heights are scaled by it).
     pub leg_length: f32,
-    /// Distance the pelvis covers per gait period, in leg lengths (`None`:
-    /// no gait found).
-    pub stride: Option<f32>,
-}
-
-/// Distance the pelvis covers per gait period, in leg lengths, of a motion
-/// at the model's rate (`None`: no gait, or it does not travel).
-fn stride_in_legs(motion: &Motion, rig: &crate::features::RigLayout) -> Option<f32> {
-    let period = crate::eval::gait_period(motion, rig)?;
-    let leg = rig.leg_length(motion.skeleton());
-    let speed = crate::contact::travelled(motion, rig) as f64 / motion.duration();
-    let stride = (speed * period) as f32 / leg;
-    (leg > 0.0 && stride > 0.05).then_some(stride)
-}
-
-/// How many times longer the source is played before restyling with
-/// [`ConvertOptions::style_pace`]: the source's stride over the styles'
-/// (weighted by their blend weights), raised to the strength, within
-/// [0.5, 2]. Elastic patches give the output the style's stride period and
-/// as many strides as the source has; with strides of the style's length,
-/// the source's path then needs `k` times as many, so the source is played
-/// `k` times slower. 1 where a clip has no gait or does not travel.
-pub fn pace_factor(
-    model: &StyleModel,
-    source: &Motion,
-    styles: &[(&StyleClip, f32)],
-    strength: f32,
-) -> Result<f64> {
-    let rig = &model.description.rig;
-    let src = model.prepare(source, "source")?;
-    let Some(source_stride) = stride_in_legs(&src, rig) else {
-        return Ok(1.0);
-    };
-    let mut weighted = 0.0;
-    let mut total = 0.0;
-    for (clip, w) in styles {
-        let Some(stride) = clip.stride else {
-            return Ok(1.0);
-        };
-        weighted += (*w * stride) as f64;
-        total += *w as f64;
-    }
-    if total <= 0.0 || weighted <= 0.0 {
-        return Ok(1.0);
-    }
-    let k = (source_stride as f64 / (weighted / total)).powf(strength as f64);
-    Ok(k.clamp(0.5, 2.0))
-}
-
-/// `source` played `k` times slower: resampled to `k` times its frames,
-/// frame time kept.
-pub fn played_slower(source: &Motion, k: f64) -> Result<Motion> {
-    let frames = ((source.frame_count() as f64 * k).round() as usize).max(2);
-    let resampled = mocap_core::ops::resample_frames(source, frames)?;
-    Ok(Motion::new(
-        resampled.skeleton().clone(),
-        source.frame_time(),
-        frames,
-        resampled.values().to_vec(),
-    )?)
 }
 
 /// Encodes a style clip and its mirror; `what` names it in errors.
@@ -259,7 +199,6 @@ pub fn prepare_style(
     Ok(StyleClip {
         sequences,
         leg_length: rig.leg_length(motion.skeleton()),
-        stride: stride_in_legs(&motion, rig),
     })
 }
 
@@ -401,16 +340,6 @@ pub fn restyle(
     options: &ConvertOptions,
     timings: StageTimings,
 ) -> Result<Restyled> {
-    let paced;
-    let source = if options.style_pace {
-        paced = played_slower(
-            source,
-            pace_factor(model, source, styles, options.strength)?,
-        )?;
-        &paced
-    } else {
-        source
-    };
     let prepared = prepare_source(model, source, options.asymmetry)?;
     restyle_prepared(model, &prepared, styles, options, timings)
 }

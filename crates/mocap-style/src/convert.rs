@@ -304,11 +304,6 @@ pub struct ConvertOptions {
     /// Whose left-right asymmetry the output keeps ([`Asymmetry`]).
     #[serde(default)]
     pub asymmetry: Asymmetry,
-    /// Play the source slower or faster first, so that the output's strides
-    /// (the style's) cover the source's path at the style's pace
-    /// ([`crate::apply::pace_factor`]); applied by [`crate::apply::restyle`].
-    #[serde(default)]
-    pub style_pace: bool,
 }
 
 impl Default for ConvertOptions {
@@ -323,7 +318,6 @@ impl Default for ConvertOptions {
             foot_contacts: false,
             root: RootPath::default(),
             asymmetry: Asymmetry::default(),
-            style_pace: false,
         }
     }
 }

@@ -36,8 +36,7 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::apply::{
-    load_model, pace_factor, played_slower, prepare_source, prepare_style, restyle_prepared,
-    StageTimings, StyleClip,
+    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings, StyleClip,
 };
 pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
@@ -875,22 +874,9 @@ fn evaluate_set(
                     method,
                     ..options.convert
                 };
-                // With the style's pace the source is played slower or
-                // faster for each style clip, so it is prepared per pair.
-                let paced = if convert.style_pace {
-                    let styles = [(&prepared[k], 1.0)];
-                    let pace = pace_factor(model, &source.motion, &styles, convert.strength)?;
-                    Some(prepare_source(
-                        model,
-                        &played_slower(&source.motion, pace)?,
-                        convert.asymmetry,
-                    )?)
-                } else {
-                    None
-                };
                 let restyled = restyle_prepared(
                     model,
-                    paced.as_ref().unwrap_or(&prepared_source),
+                    &prepared_source,
                     &[(&prepared[k], 1.0)],
                     &convert,
                     prepare_times[k],
