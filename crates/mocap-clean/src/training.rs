@@ -22,7 +22,7 @@ use burn::module::Module;
 use burn::optim::AdamConfig;
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{save_epoch, CheckpointHeader, Progress, TrainingState};
+use mocap_nn::checkpoint::{save_epoch, CheckpointHeader, TrainingState};
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
 use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
@@ -826,20 +826,16 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let device = options.device.training_device()?;
     let plain_device = options.device.device()?;
     seed_device(&device, options.seed);
-    let mut model = network.init(&device)?;
-    let mut optimizer = AdamConfig::new().init();
-    let mut history = History::default();
     let state_dir = options
         .state_dir
         .clone()
         .unwrap_or_else(|| with_extension(&options.out, "state"));
     let state = TrainingState::new(&state_dir);
-    if options.resume && state.exists() {
-        let (m, o, progress): (Denoiser, _, Progress) = state.load(model, optimizer)?;
-        model = m;
-        optimizer = o;
-        history = progress.history;
-    }
+    let (model, optimizer, mut history) = state.resume_or_start(
+        options.resume,
+        network.init(&device)?,
+        AdamConfig::new().init(),
+    )?;
     let resumed_from_epoch = history.epochs.len();
     let plot = options
         .plot

@@ -279,6 +279,24 @@ impl TrainingState {
             .map_err(|e| checkpoint_error(&self.progress_path(), e.to_string()))?;
         Ok((module, optimizer, progress))
     }
+
+    /// The model, optimizer and epoch history a training run starts from:
+    /// those saved here when `resume` is asked and a complete state is
+    /// there, else the fresh `module` and `optimizer` with no epochs.
+    pub fn resume_or_start<M: Module>(
+        &self,
+        resume: bool,
+        module: M,
+        optimizer: ModuleOptimizer,
+    ) -> Result<(M, ModuleOptimizer, crate::train::History)> {
+        if resume && self.exists() {
+            let (module, optimizer, progress): (M, ModuleOptimizer, Progress) =
+                self.load(module, optimizer)?;
+            Ok((module, optimizer, progress.history))
+        } else {
+            Ok((module, optimizer, crate::train::History::default()))
+        }
+    }
 }
 
 /// What a resumable training state records besides the weights and the

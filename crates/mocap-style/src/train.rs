@@ -25,8 +25,7 @@ use mocap_core::ops::resample_fps;
 use mocap_core::rotation::Quat;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_epoch, CheckpointHeader, Progress,
-    TrainingState,
+    header_from_bytes, load_weights_from_bytes, save_epoch, CheckpointHeader, TrainingState,
 };
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
@@ -468,21 +467,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let device = options.device.training_device()?;
     let plain_device = options.device.device()?;
     seed_device(&device, options.seed);
-    let mut model = network.init(&device)?;
-    let mut optimizer = AdamConfig::new().init();
-    let mut history = History::default();
     let state = TrainingState::new(
         options
             .state_dir
             .clone()
             .unwrap_or_else(|| options.out.with_extension("state")),
     );
-    if options.resume && state.exists() {
-        let (m, o, progress): (StyleAutoencoder, _, Progress) = state.load(model, optimizer)?;
-        model = m;
-        optimizer = o;
-        history = progress.history;
-    }
+    let (model, optimizer, mut history) = state.resume_or_start(
+        options.resume,
+        network.init(&device)?,
+        AdamConfig::new().init(),
+    )?;
     let resumed_from_epoch = history.epochs.len();
     let plot = options
         .plot
