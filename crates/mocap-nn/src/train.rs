@@ -22,13 +22,22 @@ pub struct EpochRecord {
     /// 0-based epoch index.
     pub epoch: usize,
     /// Mean training loss over the epoch's steps.
+    #[serde(deserialize_with = "nan_if_null")]
     pub train_loss: f64,
-    /// Validation loss after the epoch.
+    /// Validation loss after the epoch (NaN where there was nothing to
+    /// validate on).
+    #[serde(deserialize_with = "nan_if_null")]
     pub valid_loss: f64,
     /// Training samples seen in the epoch.
     pub samples: usize,
     /// Wall-clock seconds of the training steps (validation excluded).
     pub train_seconds: f64,
+}
+
+/// JSON has no NaN: serde_json writes a NaN loss as `null`, which a resumed
+/// run must read back as NaN.
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::NAN))
 }
 
 /// The losses of every epoch so far (what a resumed run continues).
@@ -205,6 +214,26 @@ mod tests {
     use burn::nn::{Linear, LinearConfig};
     use burn::optim::AdamConfig;
     use burn::tensor::Device;
+
+    /// A run without validation clips records NaN validation losses; its
+    /// history, written as JSON (NaN becomes `null`), reads back.
+    #[test]
+    fn a_history_without_validation_losses_reads_back() {
+        let history = History {
+            epochs: vec![EpochRecord {
+                epoch: 0,
+                train_loss: 0.5,
+                valid_loss: f64::NAN,
+                samples: 8,
+                train_seconds: 1.0,
+            }],
+        };
+        let json = serde_json::to_string(&history).unwrap();
+        assert!(json.contains("\"valid_loss\":null"), "{json}");
+        let back: History = serde_json::from_str(&json).unwrap();
+        assert!(back.epochs[0].valid_loss.is_nan());
+        assert_eq!(back.epochs[0].train_loss, 0.5);
+    }
 
     /// A loss that turns into NaN stops the run at that epoch, after the
     /// epochs before it were recorded and saved.
