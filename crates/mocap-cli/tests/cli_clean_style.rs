@@ -626,6 +626,34 @@ fn unusable_inputs_are_refused_naming_the_file() {
     );
     assert!(!output.exists());
 
+    // A one-frame source.
+    let still = dir.path().join("one-frame.bvh");
+    let out = mocap(&[
+        "convert",
+        &sample("dataset-1_walk_normal_001.bvh"),
+        path(&still),
+        "--frames",
+        "0..1",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = mocap(&[
+        "style",
+        "apply",
+        path(&still),
+        "--style",
+        &sample("dataset-1_walk_proud_001.bvh"),
+        "-o",
+        path(&output),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("one-frame.bvh") && stderr(&out).contains("at least 2"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!output.exists());
+
     // A take of another rig than the shipped denoiser's.
     let Some(other_rig) = mocap_testdata::shared("parser-cases/bvhanim_test_mocapbank.bvh") else {
         return;
