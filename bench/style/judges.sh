@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Two style judges side by side (bench/results/style.md, "A second judge: a
-# small conv net"): the forest on gait descriptors (the evaluation's judge) and
-# a small conv net on per-frame pose values, judge seeds 1-3, on both folds:
+# Three style judges side by side (bench/results/style.md, "A second judge: a
+# small conv net"): the forest on gait descriptors (the evaluation's judge), a
+# small conv net on per-frame pose values, and both with their votes added
+# (session 20), judge seeds 1-3, on both folds:
 # first on real clips (cross-validation leaving one walking content out, and
 # the held-out walks), then judging the outputs of every method.
 #
-#   bash bench/style/judges.sh     # about 45 min on the 2-core machine
+#   bash bench/style/judges.sh     # about 80 min on the 2-core machine
 #
 # Needs the other fold's model, which `bash bench/style/run.sh --other-fold`
 # trains (${MODEL_DIR:-/tmp}/style-fold-first.safetensors). The per-run JSON
@@ -15,7 +16,7 @@ source "$(dirname "$0")/setup.sh"
 require_fold_model
 RUNS=${RUNS_DIR:-/tmp/style-judges}
 mkdir -p "$RUNS"
-for judge in forest conv-net; do
+for judge in forest conv-net both; do
   for seed in 1 2 3; do
     for fold in last first; do
       FOLD_ARGS=(--held-out "$fold")

@@ -1,9 +1,9 @@
-"""Tables of bench/style/run.sh --judges: the two style judges on real clips
+"""Tables of bench/style/judges.sh: the three style judges on real clips
 and on outputs, three judge seeds, both folds.
 
 Usage: python3 bench/style/judges_table.py RUNS_DIR > bench/style/out/judges.md
-RUNS_DIR holds classifiers-{forest,conv-net}-{last,first}-seedN.json and
-eval-{forest,conv-net}-{last,first}-seedN.json.
+RUNS_DIR holds classifiers-{forest,conv-net,both}-{last,first}-seedN.json and
+eval-{forest,conv-net,both}-{last,first}-seedN.json.
 """
 import json
 import pathlib
@@ -12,7 +12,7 @@ import sys
 from reports import method_row, pooled
 
 root = pathlib.Path(sys.argv[1])
-JUDGES = ["forest", "conv-net"]
+JUDGES = ["forest", "conv-net", "both"]
 FOLDS = ["last", "first"]
 SEEDS = [1, 2, 3]
 METHODS = ["elastic-patches", "fixed-patches", "whitening-colouring", "adain"]

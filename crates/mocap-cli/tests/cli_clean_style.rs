@@ -1081,7 +1081,7 @@ fn style_eval_names_its_judges_and_settings_and_can_judge_style_with_the_conv_ne
     let out = eval("tree");
     assert_eq!(out.status.code(), Some(2));
     assert!(
-        stderr(&out).contains("expected forest or conv-net"),
+        stderr(&out).contains("expected forest, conv-net or both"),
         "{}",
         stderr(&out)
     );

@@ -6,7 +6,7 @@
 //! cargo run -p mocap-style --example classifiers -- [--cv | --cv-style | --cv-content] \
 //!     [--classifier-contents walk,walk-back] [--style-descriptor gait] \
 //!     [--content-descriptor intervals-gait] [--style-window 2] [--content-window 2] \
-//!     [--style-model forest|nearest-mean|discriminant|conv-net] [--style-judge forest|conv-net] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
+//!     [--style-model forest|nearest-mean|discriminant|conv-net] [--style-judge forest|conv-net|both] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
 //!     [--net-epochs 30] [--net-width 64] [--net-kernel 7] [--net-dropout 0.3] [--net-lr 0.001] [--net-velocities] DIR...
 //! ```
 

@@ -354,6 +354,13 @@ pub enum Model {
     /// (not the descriptor; see [`crate::classify_net`]); a clip's label is
     /// the class with the largest summed probability over its windows.
     ConvNet,
+    /// Both [`Model::Forest`] and [`Model::ConvNet`], their votes added
+    /// with equal weight (each window gives each model's class
+    /// distribution, summing to 1). The forest is trained on the clips as
+    /// they are and the network, with [`ClassifierConfig::mirror_training`],
+    /// on their mirror images too: each model in the setting it was
+    /// measured best in.
+    ForestAndConvNet,
 }
 
 /// How a classifier is built.
@@ -392,6 +399,8 @@ enum Fitted {
     Rows(RowModel),
     /// The conv net, which reads the windows themselves.
     ConvNet(Box<FittedNet>),
+    /// A forest of descriptor rows and a conv net, votes added.
+    Both(RowModel, Box<FittedNet>),
 }
 
 /// A model fitted to one descriptor row per window.
@@ -520,6 +529,12 @@ impl Fitted {
                     model.add_votes(&descriptor_row(descriptor, w, fps), votes);
                 }
             }
+            Fitted::Both(forest, net) => {
+                for w in windows {
+                    forest.add_votes(&descriptor_row(descriptor, w, fps), votes);
+                }
+                net.add_votes(windows, votes);
+            }
         }
     }
 }
@@ -574,16 +589,19 @@ impl ClipClassifier {
         // Every training window with its frame rate and class.
         let mut windows = Vec::new();
         let mut labels = Vec::new();
+        // Whether each window comes from a mirror image.
+        let mut from_mirror = Vec::new();
         for (clip, label) in clips {
             let class = classes.binary_search(label).expect("listed") as u32;
             let mut motions = vec![clip.motion.clone()];
             if config.mirror_training {
                 motions.push(mirrored(&clip.motion)?);
             }
-            for m in &motions {
+            for (k, m) in motions.iter().enumerate() {
                 for w in feature_windows(m, config.windows)? {
                     windows.push((w, m.fps()));
                     labels.push(class);
+                    from_mirror.push(k > 0);
                 }
             }
         }
@@ -595,21 +613,21 @@ impl ClipClassifier {
                 .collect()
         };
         let dim = |rows: &[f32]| rows.len() / labels.len().max(1);
-        let fitted = match config.model {
-            Model::Forest => {
-                let rows = rows();
-                let samples =
-                    Samples::new(&rows, dim(&rows), &labels, classes.len()).map_err(invalid)?;
-                let mut forest = ForestConfig {
-                    trees: config.trees,
-                    seed: config.seed,
-                    ..ForestConfig::default()
-                };
-                if let Some(c) = config.candidates {
-                    forest.tree.candidates_per_node = Some(c);
-                }
-                Fitted::Rows(RowModel::Forest(Forest::train(&samples, &forest, &|| {})))
+        let forest = |rows: &[f32], labels: &[u32]| -> Result<RowModel> {
+            let dim = rows.len() / labels.len().max(1);
+            let samples = Samples::new(rows, dim, labels, classes.len()).map_err(invalid)?;
+            let mut forest = ForestConfig {
+                trees: config.trees,
+                seed: config.seed,
+                ..ForestConfig::default()
+            };
+            if let Some(c) = config.candidates {
+                forest.tree.candidates_per_node = Some(c);
             }
+            Ok(RowModel::Forest(Forest::train(&samples, &forest, &|| {})))
+        };
+        let fitted = match config.model {
+            Model::Forest => Fitted::Rows(forest(&rows(), &labels)?),
             Model::NearestMean => {
                 let rows = rows();
                 Fitted::Rows(fit_nearest_mean(&rows, dim(&rows), &labels, classes.len()))
@@ -629,6 +647,21 @@ impl ClipClassifier {
                 let net =
                     FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
                 Fitted::ConvNet(Box::new(net))
+            }
+            Model::ForestAndConvNet => {
+                // The forest on the clips as they are.
+                let (mut rows, mut own_labels) = (Vec::new(), Vec::new());
+                for (((w, fps), &label), &mirror) in windows.iter().zip(&labels).zip(&from_mirror) {
+                    if !mirror {
+                        rows.extend(descriptor_row(config.descriptor, w, *fps));
+                        own_labels.push(label);
+                    }
+                }
+                let forest = forest(&rows, &own_labels)?;
+                let windows: Vec<FeatureSequence> = windows.into_iter().map(|(w, _)| w).collect();
+                let net =
+                    FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
+                Fitted::Both(forest, Box::new(net))
             }
         };
         Ok(ClipClassifier {

@@ -117,6 +117,8 @@ pub enum StyleJudge {
     /// The small conv net on per-frame values and their changes, trained on
     /// the clips and their mirror images (a second opinion).
     ConvNet,
+    /// Both, their votes added with equal weight (session 20).
+    Both,
 }
 
 impl std::str::FromStr for StyleJudge {
@@ -125,7 +127,10 @@ impl std::str::FromStr for StyleJudge {
         match s {
             "forest" => Ok(StyleJudge::Forest),
             "conv-net" => Ok(StyleJudge::ConvNet),
-            _ => Err(format!("style judge {s:?}: expected forest or conv-net")),
+            "both" => Ok(StyleJudge::Both),
+            _ => Err(format!(
+                "style judge {s:?}: expected forest, conv-net or both"
+            )),
         }
     }
 }
@@ -141,6 +146,11 @@ impl EvalOptions {
             }
             StyleJudge::ConvNet => {
                 self.style_model = Model::ConvNet;
+                self.net.velocities = true;
+                self.style_mirror_training = true;
+            }
+            StyleJudge::Both => {
+                self.style_model = Model::ForestAndConvNet;
                 self.net.velocities = true;
                 self.style_mirror_training = true;
             }
@@ -1127,23 +1137,27 @@ fn judge_description(
         Descriptor::Gait => "gait",
         Descriptor::IntervalsGait => "interval-means + gait",
     };
+    let net_text = format!(
+        "conv net ({} channels, kernel {}, {} epochs) on the per-frame pose values{}",
+        net.width,
+        net.kernel,
+        net.epochs,
+        if net.velocities {
+            " and their changes"
+        } else {
+            ""
+        }
+    );
     match model {
         Model::Forest => format!("forest of {trees} trees on the {descriptor} descriptor"),
+        Model::ForestAndConvNet => format!(
+            "forest of {trees} trees on the {descriptor} descriptor and {net_text}, votes added"
+        ),
         Model::NearestMean => format!("nearest class mean on the {descriptor} descriptor"),
         Model::Discriminant => {
             format!("linear discriminant (shrinkage {shrinkage}) on the {descriptor} descriptor")
         }
-        Model::ConvNet => format!(
-            "conv net ({} channels, kernel {}, {} epochs) on the per-frame pose values{}",
-            net.width,
-            net.kernel,
-            net.epochs,
-            if net.velocities {
-                " and their changes"
-            } else {
-                ""
-            }
-        ),
+        Model::ConvNet => net_text,
     }
 }
 

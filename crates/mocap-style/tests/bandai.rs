@@ -334,7 +334,8 @@ fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
 
 /// The second style judge, the small conv net on per-frame pose values,
 /// learns dataset-2 walking styles from four takes each and recognises other
-/// takes of them (the forest recognises every held-out dataset-2 walk).
+/// takes of them (the forest recognises every held-out dataset-2 walk), alone
+/// and with the forest's votes added (`--style-judge both`).
 #[test]
 fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     use mocap_style::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
@@ -359,31 +360,35 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     else {
         return;
     };
-    let config = ClassifierConfig {
-        model: Model::ConvNet,
-        descriptor: Descriptor::Gait,
-        windows: Windows::default(),
-        trees: 0,
-        candidates: None,
-        mirror_training: true,
-        shrinkage: 1.0,
-        net: NetConfig {
-            velocities: true,
-            ..NetConfig::default()
-        },
-        seed: 1,
-    };
-    let labelled: Vec<_> = train.iter().map(|c| (c, c.labels.style.clone())).collect();
-    let judge = ClipClassifier::train(&labelled, config).unwrap();
-    assert_eq!(judge.classes(), styles);
-    let mut wrong = Vec::new();
-    for clip in &test {
-        let predicted = judge.predict(&clip.motion).unwrap();
-        if predicted != clip.labels.style {
-            wrong.push((clip.name.clone(), predicted));
+    // The conv net alone, and with the forest's votes added (the forest is
+    // trained on the clips as they are, the net on their mirrors too).
+    for model in [Model::ConvNet, Model::ForestAndConvNet] {
+        let config = ClassifierConfig {
+            model,
+            descriptor: Descriptor::Gait,
+            windows: Windows::default(),
+            trees: 100,
+            candidates: None,
+            mirror_training: true,
+            shrinkage: 1.0,
+            net: NetConfig {
+                velocities: true,
+                ..NetConfig::default()
+            },
+            seed: 1,
+        };
+        let labelled: Vec<_> = train.iter().map(|c| (c, c.labels.style.clone())).collect();
+        let judge = ClipClassifier::train(&labelled, config).unwrap();
+        assert_eq!(judge.classes(), styles);
+        let mut wrong = Vec::new();
+        for clip in &test {
+            let predicted = judge.predict(&clip.motion).unwrap();
+            if predicted != clip.labels.style {
+                wrong.push((clip.name.clone(), predicted));
+            }
         }
+        assert!(wrong.len() <= 1, "{model:?}: {wrong:?}");
     }
-    assert!(wrong.len() <= 1, "{wrong:?}");
 }
 
 /// The shipped model and the held-out dataset-2 active walk, prepared as

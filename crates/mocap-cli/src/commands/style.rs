@@ -192,9 +192,10 @@ struct EvalArgs {
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
     trees: usize,
-    /// The classifier that judges the outputs' style: the forest on gait descriptors, or a
-    /// small conv net on the per-frame pose values (a second opinion; slower to train).
-    #[arg(long, default_value = "forest", value_name = "forest|conv-net")]
+    /// The classifier that judges the outputs' style: the forest on gait descriptors, a
+    /// small conv net on the per-frame pose values (a second opinion; slower to train), or
+    /// both with their votes added.
+    #[arg(long, default_value = "forest", value_name = "forest|conv-net|both")]
     style_judge: StyleJudge,
     /// Seed of the classifiers.
     #[arg(long, default_value_t = 1)]
