@@ -675,11 +675,18 @@ impl ClipClassifier {
     /// histograms, network probabilities, or minus the distances to the class
     /// means).
     pub fn predict(&self, motion: &Motion) -> Result<String> {
+        let votes = self.votes(motion)?;
+        Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
+    }
+
+    /// The summed score of every class (in the order of
+    /// [`ClipClassifier::classes`]) over the clip's windows.
+    pub fn votes(&self, motion: &Motion) -> Result<Vec<f32>> {
         let mut votes = vec![0.0f32; self.classes.len()];
         let windows = feature_windows(motion, self.config.windows)?;
         self.fitted
             .add_votes(self.config.descriptor, &windows, motion.fps(), &mut votes);
-        Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
+        Ok(votes)
     }
 
     pub fn classes(&self) -> &[String] {

@@ -360,16 +360,15 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     else {
         return;
     };
-    // The conv net alone, and with the forest's votes added (the forest is
-    // trained on the clips as they are, the net on their mirrors too).
-    for model in [Model::ConvNet, Model::ForestAndConvNet] {
+    let labelled: Vec<_> = train.iter().map(|c| (c, c.labels.style.clone())).collect();
+    let judge = |model, mirror_training| {
         let config = ClassifierConfig {
             model,
             descriptor: Descriptor::Gait,
             windows: Windows::default(),
             trees: 100,
             candidates: None,
-            mirror_training: true,
+            mirror_training,
             shrinkage: 1.0,
             net: NetConfig {
                 velocities: true,
@@ -377,8 +376,13 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
             },
             seed: 1,
         };
-        let labelled: Vec<_> = train.iter().map(|c| (c, c.labels.style.clone())).collect();
-        let judge = ClipClassifier::train(&labelled, config).unwrap();
+        ClipClassifier::train(&labelled, config).unwrap()
+    };
+    // The conv net alone, and with the forest's votes added (the forest is
+    // trained on the clips as they are, the net on their mirrors too).
+    let net = judge(Model::ConvNet, true);
+    let both = judge(Model::ForestAndConvNet, true);
+    for judge in [&net, &both] {
         assert_eq!(judge.classes(), styles);
         let mut wrong = Vec::new();
         for clip in &test {
@@ -387,7 +391,20 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
                 wrong.push((clip.name.clone(), predicted));
             }
         }
-        assert!(wrong.len() <= 1, "{model:?}: {wrong:?}");
+        assert!(wrong.len() <= 1, "{wrong:?}");
+    }
+    // The votes of both are the forest's (on the clips as they are) plus
+    // the net's, same seeds.
+    let forest = judge(Model::Forest, false);
+    for clip in &test {
+        let (f, n, b) = (
+            forest.votes(&clip.motion).unwrap(),
+            net.votes(&clip.motion).unwrap(),
+            both.votes(&clip.motion).unwrap(),
+        );
+        for k in 0..styles.len() {
+            assert!((f[k] + n[k] - b[k]).abs() < 1e-3, "{f:?} + {n:?} vs {b:?}");
+        }
     }
 }
 
