@@ -6,7 +6,8 @@
 # first on real clips (cross-validation leaving one walking content out, and
 # the held-out walks), then judging the outputs of every method.
 #
-#   bash bench/style/judges.sh     # about 80 min on the 2-core machine
+#   bash bench/style/judges.sh     # about 90 min on the 2-core machine (the third judge: 16 min on
+#                                  # real clips and 27 min of evaluations, measured in session 20)
 #
 # Needs the other fold's model, which `bash bench/style/run.sh --other-fold`
 # trains (${MODEL_DIR:-/tmp}/style-fold-first.safetensors). The per-run JSON
