@@ -557,13 +557,9 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
     let t = Instant::now();
     let model = load_model(options.model.as_deref(), options.device)?;
     let source = read_motion(&options.source)?;
-    if source.frame_count() < 2 {
-        return Err(invalid(format!(
-            "{}: the source has {} frame(s); restyling needs at least 2",
-            options.source.display(),
-            source.frame_count()
-        )));
-    }
+    // Checked here too, where the source's file name is known: the restyle
+    // itself names it only "source".
+    crate::train::require_two_frames(&source, &options.source.display().to_string())?;
     let style = read_motion(&options.style)?;
     let blend = match &options.blend {
         Some((path, w)) => Some((read_motion(path)?, *w, path)),

@@ -204,9 +204,7 @@ impl StyleModel {
         self.description
             .rig
             .check_skeleton(motion.skeleton(), what)?;
-        if motion.frame_count() < 2 {
-            return Err(invalid(format!("{what}: needs at least 2 frames")));
-        }
+        require_two_frames(motion, what)?;
         if (motion.fps() - self.description.fps).abs() > 1e-3 * self.description.fps {
             Ok(resample_fps(motion, self.description.fps)?)
         } else {
@@ -234,6 +232,18 @@ impl StyleModel {
         let x = self.network.decode(z);
         Ok(from_tensor(x, latents.frames)?.data)
     }
+}
+
+/// A clip to encode needs at least two frames; `what` names it in the error
+/// (a file path where the caller has one).
+pub(crate) fn require_two_frames(motion: &Motion, what: &str) -> Result<()> {
+    if motion.frame_count() < 2 {
+        return Err(invalid(format!(
+            "{what}: {} frame(s); needs at least 2 frames",
+            motion.frame_count()
+        )));
+    }
+    Ok(())
 }
 
 /// `[1, channels, frames]` tensor of frame-major values.
