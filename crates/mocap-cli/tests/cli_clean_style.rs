@@ -597,62 +597,56 @@ fn style_apply_restyles_the_bundled_walk() {
 #[test]
 fn unusable_inputs_are_refused_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    // A style clip shorter than one patch.
-    let short = dir.path().join("short-style.bvh");
-    let out = mocap(&[
-        "convert",
-        &sample("dataset-1_walk_proud_001.bvh"),
-        path(&short),
-        "--frames",
-        "0..8",
-        "--quiet",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let output = dir.path().join("out.bvh");
-    let out = mocap(&[
-        "style",
-        "apply",
+    // Frames `frames` of a bundled walk, written as `name`.
+    let cut = |walk: &str, name: &str, frames: &str| {
+        let clip = dir.path().join(name);
+        let out = mocap(&[
+            "convert",
+            &sample(walk),
+            path(&clip),
+            "--frames",
+            frames,
+            "--quiet",
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        clip
+    };
+    // `style apply` fails, naming `file` and saying `says`, and writes nothing.
+    let refused = |source: &str, style: &str, file: &str, says: &str| {
+        let out = mocap(&[
+            "style",
+            "apply",
+            source,
+            "--style",
+            style,
+            "-o",
+            path(&output),
+        ]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(
+            stderr(&out).contains(file) && stderr(&out).contains(says),
+            "{}",
+            stderr(&out)
+        );
+        assert!(!output.exists());
+    };
+    // A style clip shorter than one patch.
+    let short = cut("dataset-1_walk_proud_001.bvh", "short-style.bvh", "0..8");
+    refused(
         &sample("dataset-1_walk_normal_001.bvh"),
-        "--style",
         path(&short),
-        "-o",
-        path(&output),
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("short-style.bvh") && stderr(&out).contains("too short"),
-        "{}",
-        stderr(&out)
+        "short-style.bvh",
+        "too short",
     );
-    assert!(!output.exists());
-
     // A one-frame source.
-    let still = dir.path().join("one-frame.bvh");
-    let out = mocap(&[
-        "convert",
-        &sample("dataset-1_walk_normal_001.bvh"),
+    let still = cut("dataset-1_walk_normal_001.bvh", "one-frame.bvh", "0..1");
+    refused(
         path(&still),
-        "--frames",
-        "0..1",
-        "--quiet",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let out = mocap(&[
-        "style",
-        "apply",
-        path(&still),
-        "--style",
         &sample("dataset-1_walk_proud_001.bvh"),
-        "-o",
-        path(&output),
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("one-frame.bvh") && stderr(&out).contains("at least 2"),
-        "{}",
-        stderr(&out)
+        "one-frame.bvh",
+        "at least 2",
     );
-    assert!(!output.exists());
 
     // A take of another rig than the shipped denoiser's.
     let Some(other_rig) = mocap_testdata::shared("parser-cases/bvhanim_test_mocapbank.bvh") else {
