@@ -586,11 +586,10 @@ impl ClipClassifier {
         let mut classes: Vec<String> = clips.iter().map(|c| c.1.clone()).collect();
         classes.sort();
         classes.dedup();
-        // Every training window with its frame rate and class.
-        let mut windows = Vec::new();
-        let mut labels = Vec::new();
-        // Whether each window comes from a mirror image.
-        let mut from_mirror = Vec::new();
+        // Every training window with its frame rate, its class and whether
+        // it comes from a mirror image.
+        let (mut windows, mut fps, mut labels, mut from_mirror) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (clip, label) in clips {
             let class = classes.binary_search(label).expect("listed") as u32;
             let mut motions = vec![clip.motion.clone()];
@@ -599,23 +598,32 @@ impl ClipClassifier {
             }
             for (k, m) in motions.iter().enumerate() {
                 for w in feature_windows(m, config.windows)? {
-                    windows.push((w, m.fps()));
+                    windows.push(w);
+                    fps.push(m.fps());
                     labels.push(class);
                     from_mirror.push(k > 0);
                 }
             }
         }
-        // The row models see one descriptor row per window.
-        let rows = || -> Vec<f32> {
-            windows
-                .iter()
-                .flat_map(|(w, fps)| descriptor_row(config.descriptor, w, *fps))
-                .collect()
+        // The row models see one descriptor row per window (without
+        // `mirrors`, only the windows of the clips as they are), with its
+        // class.
+        let rows = |mirrors: bool| -> (Vec<f32>, Vec<u32>) {
+            let (mut rows, mut kept) = (Vec::new(), Vec::new());
+            for (((w, &fps), &label), &mirror) in
+                windows.iter().zip(&fps).zip(&labels).zip(&from_mirror)
+            {
+                if mirrors || !mirror {
+                    rows.extend(descriptor_row(config.descriptor, w, fps));
+                    kept.push(label);
+                }
+            }
+            (rows, kept)
         };
-        let dim = |rows: &[f32]| rows.len() / labels.len().max(1);
-        let forest = |rows: &[f32], labels: &[u32]| -> Result<RowModel> {
-            let dim = rows.len() / labels.len().max(1);
-            let samples = Samples::new(rows, dim, labels, classes.len()).map_err(invalid)?;
+        let dim = |rows: &[f32], labels: &[u32]| rows.len() / labels.len().max(1);
+        let forest = |(rows, labels): (Vec<f32>, Vec<u32>)| -> Result<RowModel> {
+            let samples = Samples::new(&rows, dim(&rows, &labels), &labels, classes.len())
+                .map_err(invalid)?;
             let mut forest = ForestConfig {
                 trees: config.trees,
                 seed: config.seed,
@@ -626,43 +634,34 @@ impl ClipClassifier {
             }
             Ok(RowModel::Forest(Forest::train(&samples, &forest, &|| {})))
         };
+        let net = || -> Result<Box<FittedNet>> {
+            let net = FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
+            Ok(Box::new(net))
+        };
         let fitted = match config.model {
-            Model::Forest => Fitted::Rows(forest(&rows(), &labels)?),
+            Model::Forest => Fitted::Rows(forest(rows(true))?),
             Model::NearestMean => {
-                let rows = rows();
-                Fitted::Rows(fit_nearest_mean(&rows, dim(&rows), &labels, classes.len()))
+                let (rows, labels) = rows(true);
+                Fitted::Rows(fit_nearest_mean(
+                    &rows,
+                    dim(&rows, &labels),
+                    &labels,
+                    classes.len(),
+                ))
             }
             Model::Discriminant => {
-                let rows = rows();
+                let (rows, labels) = rows(true);
                 Fitted::Rows(fit_discriminant(
                     &rows,
-                    dim(&rows),
+                    dim(&rows, &labels),
                     &labels,
                     classes.len(),
                     config.shrinkage,
                 )?)
             }
-            Model::ConvNet => {
-                let windows: Vec<FeatureSequence> = windows.into_iter().map(|(w, _)| w).collect();
-                let net =
-                    FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
-                Fitted::ConvNet(Box::new(net))
-            }
-            Model::ForestAndConvNet => {
-                // The forest on the clips as they are.
-                let (mut rows, mut own_labels) = (Vec::new(), Vec::new());
-                for (((w, fps), &label), &mirror) in windows.iter().zip(&labels).zip(&from_mirror) {
-                    if !mirror {
-                        rows.extend(descriptor_row(config.descriptor, w, *fps));
-                        own_labels.push(label);
-                    }
-                }
-                let forest = forest(&rows, &own_labels)?;
-                let windows: Vec<FeatureSequence> = windows.into_iter().map(|(w, _)| w).collect();
-                let net =
-                    FittedNet::train(&windows, &labels, classes.len(), &config.net, config.seed)?;
-                Fitted::Both(forest, Box::new(net))
-            }
+            Model::ConvNet => Fitted::ConvNet(net()?),
+            // The forest on the clips as they are, the net on all windows.
+            Model::ForestAndConvNet => Fitted::Both(forest(rows(false))?, net()?),
         };
         Ok(ClipClassifier {
             config,
