@@ -22,8 +22,10 @@
 //!    ([`mocap_core::metrics::jitter`]).
 //!
 //! The classifiers' accuracy on the real test clips is reported as their
-//! ceiling, and the "source unchanged" row shows the style accuracy of doing
-//! nothing.
+//! ceiling, the "source unchanged" row shows the style accuracy of doing
+//! nothing, and the "style clip through the autoencoder" row (each style
+//! clip encoded and decoded with no conversion) how much of the style the
+//! model's latent space keeps: what a restyle could carry at most.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -284,12 +286,30 @@ pub struct SetReport {
     pub style_chance: f64,
     /// Held-out clips too short to restyle or time (shorter than two patches).
     pub skipped_clips: Vec<String>,
-    /// The real clips: "source unchanged" (scored against the style clip's
-    /// label) and "style clip" (each style clip scored as itself).
+    /// The references: "source unchanged" (the real source scored against
+    /// the style clip's label), "style clip itself" (each real style clip
+    /// scored as itself) and "style clip through the autoencoder" (each
+    /// style clip encoded and decoded, scored as itself).
     pub reference: Vec<MethodScores>,
+    /// How the style judge reads each style clip, as it is and through the
+    /// autoencoder (the two style-clip rows of `reference`, clip by clip).
+    #[serde(default)]
+    pub style_clip_readings: Vec<StyleClipReading>,
     pub methods: Vec<MethodScores>,
     pub pairs: Vec<PairResult>,
     pub filmstrips: Vec<PathBuf>,
+}
+
+/// The style judge's reading of one held-out style clip.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct StyleClipReading {
+    pub clip: String,
+    /// Its label.
+    pub style: String,
+    /// The style judged on the real clip.
+    pub as_captured: String,
+    /// The style judged on the clip encoded and decoded by the model.
+    pub through_autoencoder: String,
 }
 
 /// What `mocap style eval` reports.
@@ -1034,9 +1054,65 @@ fn evaluate_set(
             })
         })
         .collect::<Result<_>>()?;
+    // Each style clip through the autoencoder alone (encoded and decoded
+    // with no conversion: strength 0 on itself): how much of its style the
+    // model's latent space keeps, the most a restyle with it could carry.
+    let reconstruction = ConvertOptions {
+        strength: 0.0,
+        fade_in_frames: 0.0,
+        ..options.convert
+    };
+    let decoded_rows: Vec<PairResult> = style_clips
+        .iter()
+        .zip(&prepared)
+        .map(|(c, style)| -> Result<PairResult> {
+            let source = prepare_source(model, &c.motion, reconstruction.asymmetry)?;
+            let out = restyle_prepared(
+                model,
+                &source,
+                &[(style, 1.0)],
+                &reconstruction,
+                StageTimings::default(),
+            )?
+            .motion;
+            let measures = MotionMeasures::of(&out, rig);
+            Ok(PairResult {
+                source: c.name.clone(),
+                style_clip: c.name.clone(),
+                method: Method::ElasticPatches,
+                predicted_style: style_classifier.predict(&out)?,
+                predicted_content: content_classifier.predict(&out)?,
+                period_output: gait_period(&out, rig),
+                period_style: periods[&c.name],
+                period_source: periods[&c.name],
+                foot_skating: measures.foot_skating,
+                planted_foot_sliding: measures.planted_foot_sliding,
+                foot_reach: measures.foot_reach,
+                jitter: measures.jitter,
+                time_scale: out.duration() / c.motion.duration(),
+                distance_ratio: (travelled(&out, rig) / travelled(&c.motion, rig)) as f64,
+                root_shift: 0.0,
+                timings: StageTimings::default(),
+            })
+        })
+        .collect::<Result<_>>()?;
+    let style_clip_readings = style_clips
+        .iter()
+        .zip(style_rows.iter().zip(&decoded_rows))
+        .map(|(c, (real, decoded))| StyleClipReading {
+            clip: c.name.clone(),
+            style: c.labels.style.clone(),
+            as_captured: real.predicted_style.clone(),
+            through_autoencoder: decoded.predicted_style.clone(),
+        })
+        .collect();
     let reference = vec![
         score("source unchanged".into(), source_rows.iter().collect()),
         score("style clip itself".into(), style_rows.iter().collect()),
+        score(
+            "style clip through the autoencoder".into(),
+            decoded_rows.iter().collect(),
+        ),
     ];
     Ok(SetReport {
         set: set.to_string(),
@@ -1049,6 +1125,7 @@ fn evaluate_set(
         classifier_content_accuracy: content_hits as f64 / test_clips.len() as f64,
         skipped_clips,
         reference,
+        style_clip_readings,
         methods,
         pairs,
         filmstrips,
@@ -1258,6 +1335,27 @@ impl EvalReport {
                 ));
             }
             s.push('\n');
+            let misread = |through: fn(&StyleClipReading) -> &str| -> String {
+                let list: Vec<String> = set
+                    .style_clip_readings
+                    .iter()
+                    .filter(|r| through(r) != r.style)
+                    .map(|r| format!("{} as {}", r.clip, through(r)))
+                    .collect();
+                if list.is_empty() {
+                    "none".into()
+                } else {
+                    list.join(", ")
+                }
+            };
+            if !set.style_clip_readings.is_empty() {
+                s.push_str(&format!(
+                    "Style clips the style classifier misreads: as captured: {}; through the \
+                     autoencoder: {}.\n\n",
+                    misread(|r| &r.as_captured),
+                    misread(|r| &r.through_autoencoder),
+                ));
+            }
         }
         s
     }
