@@ -22,8 +22,10 @@ if flag --train; then
   # The shipped default: the report's setting (240-frame windows, batch 16,
   # Adam, lr 1e-4), walking takes of both sets without the held-out takes,
   # with mirrored copies, seed 1, and the loss on the planted feet at weight
-  # 300 (session 19; style.md, "A loss on the feet").
-  "$BIN/style_train" --epochs 30 --steps 100 --seed 1 --contents "$WALKS" --foot-loss 300 \
+  # 300 (session 19; style.md, "A loss on the feet"), 9,000 steps (90 epochs
+  # of 100; 30 before session 21, whose validation loss was still falling:
+  # style.md, "Longer training").
+  "$BIN/style_train" --epochs 90 --steps 100 --seed 1 --contents "$WALKS" --foot-loss 300 \
     -o models/style-default.safetensors "$DATA/dataset-1" "$DATA/dataset-2" > "$OUT/train.json"
   cp models/style-default.png bench/style/loss.png
   # The loss plot goes to bench/style; the resumable state is not shipped.
@@ -97,7 +99,7 @@ if flag --other-fold; then
   # style.md, "The other fold".
   FOLD=$OUT/fold-first
   mkdir -p "$FOLD"
-  "$BIN/style_train" --held-out first --epochs 30 --steps 100 --seed 1 --contents "$WALKS" \
+  "$BIN/style_train" --held-out first --epochs 90 --steps 100 --seed 1 --contents "$WALKS" \
     --foot-loss 300 -o "$FOLD_MODEL" "$DATA/dataset-1" "$DATA/dataset-2" > "$FOLD/train.json"
   "$BIN/style_eval" --held-out first --model "$FOLD_MODEL" \
     --sources walk,walk-turn-left,walk-turn-right --styles walk \

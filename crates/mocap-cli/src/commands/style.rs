@@ -41,6 +41,8 @@ struct TrainArgs {
     /// shipped model: walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right).
     #[arg(long, value_delimiter = ',')]
     contents: Vec<String>,
+    /// Epochs of `--steps` batches (default 30; the shipped model: 90, whose validation loss was
+    /// still falling at 30: bench/results/style.md, "Longer training").
     #[arg(long)]
     epochs: Option<usize>,
     #[arg(long)]
