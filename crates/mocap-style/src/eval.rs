@@ -496,6 +496,38 @@ fn mean_or_zero(speeds: &[f32]) -> f64 {
     }
 }
 
+/// A motion judged and measured on its own: the style and content the
+/// classifiers give it, its gait period and [`MotionMeasures`]. What it was
+/// made from (source, style clip, method, the partners' periods, time
+/// scale, distance ratio, root shift, timings) is left neutral for the
+/// caller to fill in.
+fn judged(
+    motion: &Motion,
+    rig: &RigLayout,
+    style_classifier: &ClipClassifier,
+    content_classifier: &ClipClassifier,
+) -> Result<PairResult> {
+    let measures = MotionMeasures::of(motion, rig);
+    Ok(PairResult {
+        source: String::new(),
+        style_clip: String::new(),
+        method: Method::ElasticPatches,
+        predicted_style: style_classifier.predict(motion)?,
+        predicted_content: content_classifier.predict(motion)?,
+        period_output: gait_period(motion, rig),
+        period_style: None,
+        period_source: None,
+        foot_skating: measures.foot_skating,
+        planted_foot_sliding: measures.planted_foot_sliding,
+        foot_reach: measures.foot_reach,
+        jitter: measures.jitter,
+        time_scale: 1.0,
+        distance_ratio: 1.0,
+        root_shift: 0.0,
+        timings: StageTimings::default(),
+    })
+}
+
 /// The evaluation's foot measures and jitter of one motion, from one
 /// forward kinematics pass.
 #[derive(Debug, Clone, Copy)]
@@ -876,24 +908,10 @@ fn evaluate_set(
         let prepared_source = prepare_source(model, &source.motion, options.convert.asymmetry)?;
         // The source as it is, scored once; each pair's "source unchanged"
         // row takes the style clip's name and period.
-        let measures = MotionMeasures::of(&source.motion, rig);
         let unchanged = PairResult {
             source: source.name.clone(),
-            style_clip: String::new(),
-            method: Method::ElasticPatches,
-            predicted_style: style_classifier.predict(&source.motion)?,
-            predicted_content: content_classifier.predict(&source.motion)?,
-            period_output: periods[&source.name],
-            period_style: None,
             period_source: periods[&source.name],
-            foot_skating: measures.foot_skating,
-            planted_foot_sliding: measures.planted_foot_sliding,
-            foot_reach: measures.foot_reach,
-            jitter: measures.jitter,
-            time_scale: 1.0,
-            distance_ratio: 1.0,
-            root_shift: 0.0,
-            timings: StageTimings::default(),
+            ..judged(&source.motion, rig, &style_classifier, &content_classifier)?
         };
         for (k, style) in style_clips.iter().enumerate() {
             if source.name == style.name {
@@ -912,24 +930,17 @@ fn evaluate_set(
                     prepare_times[k],
                 )?;
                 let out = &restyled.motion;
-                let measures = MotionMeasures::of(out, rig);
                 pairs.push(PairResult {
                     source: source.name.clone(),
                     style_clip: style.name.clone(),
                     method,
-                    predicted_style: style_classifier.predict(out)?,
-                    predicted_content: content_classifier.predict(out)?,
-                    period_output: gait_period(out, rig),
                     period_style: periods[&style.name],
                     period_source: periods[&source.name],
-                    foot_skating: measures.foot_skating,
-                    planted_foot_sliding: measures.planted_foot_sliding,
-                    foot_reach: measures.foot_reach,
-                    jitter: measures.jitter,
                     time_scale: out.duration() / source.motion.duration(),
                     distance_ratio: (travelled(out, rig) / source_distance) as f64,
                     root_shift: restyled.root_shift.mean as f64,
                     timings: restyled.timings,
+                    ..judged(out, rig, &style_classifier, &content_classifier)?
                 });
             }
             // The source left unchanged, scored against the style clip.
@@ -1033,24 +1044,12 @@ fn evaluate_set(
     let style_rows: Vec<PairResult> = style_clips
         .iter()
         .map(|c| -> Result<PairResult> {
-            let measures = MotionMeasures::of(&c.motion, rig);
             Ok(PairResult {
                 source: c.name.clone(),
                 style_clip: c.name.clone(),
-                method: Method::ElasticPatches,
-                predicted_style: style_classifier.predict(&c.motion)?,
-                predicted_content: content_classifier.predict(&c.motion)?,
-                period_output: periods[&c.name],
                 period_style: periods[&c.name],
                 period_source: periods[&c.name],
-                foot_skating: measures.foot_skating,
-                planted_foot_sliding: measures.planted_foot_sliding,
-                foot_reach: measures.foot_reach,
-                jitter: measures.jitter,
-                time_scale: 1.0,
-                distance_ratio: 1.0,
-                root_shift: 0.0,
-                timings: StageTimings::default(),
+                ..judged(&c.motion, rig, &style_classifier, &content_classifier)?
             })
         })
         .collect::<Result<_>>()?;
@@ -1075,24 +1074,14 @@ fn evaluate_set(
                 StageTimings::default(),
             )?
             .motion;
-            let measures = MotionMeasures::of(&out, rig);
             Ok(PairResult {
                 source: c.name.clone(),
                 style_clip: c.name.clone(),
-                method: Method::ElasticPatches,
-                predicted_style: style_classifier.predict(&out)?,
-                predicted_content: content_classifier.predict(&out)?,
-                period_output: gait_period(&out, rig),
                 period_style: periods[&c.name],
                 period_source: periods[&c.name],
-                foot_skating: measures.foot_skating,
-                planted_foot_sliding: measures.planted_foot_sliding,
-                foot_reach: measures.foot_reach,
-                jitter: measures.jitter,
                 time_scale: out.duration() / c.motion.duration(),
                 distance_ratio: (travelled(&out, rig) / travelled(&c.motion, rig)) as f64,
-                root_shift: 0.0,
-                timings: StageTimings::default(),
+                ..judged(&out, rig, &style_classifier, &content_classifier)?
             })
         })
         .collect::<Result<_>>()?;
