@@ -23,6 +23,13 @@ fn sample(name: &str) -> String {
     mocap_testdata::sample(name).display().to_string()
 }
 
+/// `mocap style apply SOURCE --style STYLE -o OUT`, then `extra` options.
+fn style_apply(source: &str, style: &str, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["style", "apply", source, "--style", style, "-o", path(out)];
+    args.extend_from_slice(extra);
+    mocap(&args)
+}
+
 fn path(p: &Path) -> &str {
     p.to_str().expect("utf-8 temp path")
 }
@@ -448,18 +455,9 @@ fn style_apply_restyles_the_bundled_walk() {
     let output = dir.path().join("proud.bvh");
     // `mocap style apply` of the walk in the proud style, with `extra`.
     let apply = |extra: &[&str]| {
-        let mut args = vec![
-            "style",
-            "apply",
-            &source,
-            "--style",
-            &style,
-            "-o",
-            path(&output),
-            "--json",
-        ];
+        let mut args = vec!["--json"];
         args.extend_from_slice(extra);
-        mocap(&args)
+        style_apply(&source, &style, &output, &args)
     };
     // Restyles with `extra` options: the JSON report and the output.
     let restyle = |extra: &[&str]| {
@@ -580,15 +578,12 @@ fn style_apply_restyles_the_bundled_walk() {
     let out = apply(&["--fade-in", "soon"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("--fade-in"), "{}", stderr(&out));
-    let out = mocap(&[
-        "style",
-        "apply",
+    let out = style_apply(
         &source,
-        "--style",
         path(&dir.path().join("nope.bvh")),
-        "-o",
-        path(&dir.path().join("x.bvh")),
-    ]);
+        &dir.path().join("x.bvh"),
+        &[],
+    );
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("nope.bvh"), "{}", stderr(&out));
     assert!(!dir.path().join("x.bvh").exists());
@@ -614,15 +609,7 @@ fn unusable_inputs_are_refused_naming_the_file() {
     };
     // `style apply` fails, naming `file` and saying `says`, and writes nothing.
     let refused = |source: &str, style: &str, file: &str, says: &str| {
-        let out = mocap(&[
-            "style",
-            "apply",
-            source,
-            "--style",
-            style,
-            "-o",
-            path(&output),
-        ]);
+        let out = style_apply(source, style, &output, &[]);
         assert_eq!(out.status.code(), Some(1));
         assert!(
             stderr(&out).contains(file) && stderr(&out).contains(says),
@@ -692,18 +679,7 @@ fn style_clips_and_sources_of_other_rigs_are_retargeted() {
 
     // As a style clip: retargeted onto the source's rig, and said so.
     let output = dir.path().join("out.bvh");
-    let apply = |source: &str, style: &str| {
-        mocap(&[
-            "style",
-            "apply",
-            source,
-            "--style",
-            style,
-            "-o",
-            path(&output),
-            "--json",
-        ])
-    };
+    let apply = |source: &str, style: &str| style_apply(source, style, &output, &["--json"]);
     let out = apply(&normal, path(&proud_mixamo));
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -915,17 +891,7 @@ fn style_apply_says_when_the_source_is_unlike_the_walks_the_model_knows() {
     let dir = tempfile::tempdir().unwrap();
     let out_path = dir.path().join("out.bvh");
     let proud = sample("dataset-1_walk_proud_001.bvh");
-    let apply = |source: &str| {
-        mocap(&[
-            "style",
-            "apply",
-            source,
-            "--style",
-            &proud,
-            "-o",
-            path(&out_path),
-        ])
-    };
+    let apply = |source: &str| style_apply(source, &proud, &out_path, &[]);
     // A walk: reproduced closely, no note.
     let walk = mocap_testdata::sample_walk().display().to_string();
     let out = apply(&walk);
@@ -999,15 +965,7 @@ fn style_apply_reads_an_amc_source_as_its_converted_bvh() {
     let proud = sample("dataset-1_walk_proud_001.bvh");
     let restyle = |source: &Path, name: &str| {
         let out_path = tmp.path().join(name);
-        let out = mocap(&[
-            "style",
-            "apply",
-            path(source),
-            "--style",
-            &proud,
-            "-o",
-            path(&out_path),
-        ]);
+        let out = style_apply(path(source), &proud, &out_path, &[]);
         assert!(out.status.success(), "{}", stderr(&out));
         read_bvh(&out_path).unwrap()
     };

@@ -146,13 +146,13 @@ impl EvalOptions {
                 self.style_model = Model::Forest;
                 self.style_mirror_training = false;
             }
-            StyleJudge::ConvNet => {
-                self.style_model = Model::ConvNet;
-                self.net.velocities = true;
-                self.style_mirror_training = true;
-            }
-            StyleJudge::Both => {
-                self.style_model = Model::ForestAndConvNet;
+            StyleJudge::ConvNet | StyleJudge::Both => {
+                self.style_model = match judge {
+                    StyleJudge::ConvNet => Model::ConvNet,
+                    _ => Model::ForestAndConvNet,
+                };
+                // The net's measured setting; with both, the forest still
+                // trains on the clips as they are (`ClipClassifier::train`).
                 self.net.velocities = true;
                 self.style_mirror_training = true;
             }
