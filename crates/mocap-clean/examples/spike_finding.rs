@@ -72,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             threshold,
                             global,
                             max_frames: 90,
+                            trunk_by_subtree: false,
                         }),
                     ));
                 }
@@ -91,6 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     threshold,
                     global: true,
                     max_frames,
+                    trunk_by_subtree: false,
                 }),
             ));
         }
@@ -106,6 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 threshold: 3.0,
                 global: false,
                 max_frames: 90,
+                trunk_by_subtree: false,
             },
         ),
         (

@@ -164,6 +164,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     span: 3,
                     global: false,
                     max_frames: 90,
+                    trunk_by_subtree: false,
                 };
                 let (found_bridged_after, found_after) =
                     remove_spikes(&model.clean(&spiked, None).expect("clean"), &on_output);

@@ -22,9 +22,15 @@
 //! 3. a joint whose own jump and whose subtree's jump both exceed
 //!    [`DespikeOptions::threshold`], while no joint above it does, is at a
 //!    *boundary* of a spike, where its subtree's jump is the largest within
-//!    `span - 1` frames. The root never is, nor a joint with no rotating
-//!    joint below it (its own jump is all there is to go by: a toe that
-//!    rests and then moves would do);
+//!    `span - 1` frames. A trunk joint (the pelvis and the spine: its
+//!    subtree branches into several limbs) needs only its subtree's jump
+//!    ([`DespikeOptions::trunk_by_subtree`]): a spike there swaps several
+//!    limbs at once, while the trunk itself, upright in both motions, often
+//!    hardly jumps, and a joint's own jump alone would pass such spikes
+//!    down to single limbs, whose boundaries then rarely pair. The root
+//!    never is a boundary, nor a joint with no rotating joint below it (its
+//!    own jump is all there is to go by: a toe that rests and then moves
+//!    would do);
 //! 4. boundaries of the same joint are paired in time order, the first
 //!    opening and the second closing a spike, when they lie at most
 //!    [`DespikeOptions::max_frames`] apart (intermittent spikes give several
@@ -64,6 +70,14 @@ pub struct DespikeOptions {
     /// better in global rotations (bench/results/clean.md).
     #[serde(default)]
     pub global: bool,
+    /// Judge a trunk joint (one whose subtree branches into several limbs:
+    /// the pelvis and the spine of a body) by its subtree's jump alone, not
+    /// also by its own. A spike there swaps several limbs, which jump, but
+    /// the trunk joint itself often turns little: both the take and the
+    /// motion it was swapped with stand upright (bench/results/clean.md,
+    /// "Spikes of the trunk").
+    #[serde(default)]
+    pub trunk_by_subtree: bool,
 }
 
 impl Default for DespikeOptions {
@@ -77,6 +91,7 @@ impl Default for DespikeOptions {
             max_frames: 90,
             span: 1,
             global: true,
+            trunk_by_subtree: true,
         }
     }
 }
@@ -117,6 +132,21 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
                 .collect()
         })
         .collect();
+    // Trunk joints: some joint in the subtree has two or more children
+    // with rotating joints below them (a joint without channels between
+    // counts as the branch it leads to).
+    let branching: Vec<bool> = (0..n)
+        .map(|k| {
+            skeleton
+                .children(k)
+                .filter(|&c| !subtrees[c].is_empty())
+                .count()
+                >= 2
+        })
+        .collect();
+    let trunk: Vec<bool> = (0..n)
+        .map(|j| skeleton.subtree(j).into_iter().any(|k| branching[k]))
+        .collect();
     // Candidate boundaries per joint (frame, subtree jump), in time order.
     let mut candidates: Vec<Vec<(usize, f32)>> = vec![Vec::new(); n];
     let mut values = Vec::new();
@@ -127,9 +157,10 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
         for j in 0..n {
             // A root is never a spike (its subtree is the whole body, and
             // the root carries the translation).
+            let own_counts = !(options.trunk_by_subtree && trunk[j]);
             if skeleton.joint(j).parent.is_none()
                 || subtrees[j].len() < 2
-                || jump[t * n + j] <= options.threshold
+                || (own_counts && jump[t * n + j] <= options.threshold)
             {
                 jumps[j] = false;
                 continue;
@@ -455,6 +486,42 @@ mod tests {
                 assert!(global[t * n + k] > local[t * n + k], "{t} {k}");
             }
         }
+    }
+
+    #[test]
+    fn a_trunk_spike_is_found_at_the_trunk_joint_though_it_hardly_turns() {
+        // A spike of the pelvis: the motion swapped in stands as upright (its
+        // pelvis turned by one degree), but its spine and leg turn otherwise.
+        let clean = branching_motion(200);
+        let mut spiked = clean.clone();
+        let limb = Quat::from_rotation_x(60f32.to_radians());
+        let pelvis = Quat::from_rotation_x(1f32.to_radians());
+        for f in 80..120 {
+            for (j, turn) in [(1, pelvis), (2, limb), (3, limb), (5, limb), (6, limb)] {
+                spiked.set_local_rotation(f, j, clean.local_rotation(f, j) * turn);
+            }
+        }
+        let trunk = DespikeOptions::default();
+        assert!(trunk.trunk_by_subtree);
+        assert_eq!(
+            find_spikes(&spiked, &trunk),
+            vec![FoundSpike {
+                joint: 1,
+                start: 80,
+                frames: 40
+            }]
+        );
+        // Judged by its own jump as well, the pelvis is passed over and the
+        // spike is found below it, at the spine and the leg.
+        let own_too = DespikeOptions {
+            trunk_by_subtree: false,
+            ..trunk
+        };
+        let found: Vec<usize> = find_spikes(&spiked, &own_too)
+            .iter()
+            .map(|s| s.joint)
+            .collect();
+        assert_eq!(found, vec![2, 5]);
     }
 
     #[test]
