@@ -191,10 +191,16 @@ fn rng_for(seed: u64, take: usize, condition: usize) -> ChaCha8Rng {
     )
 }
 
-/// The noisy copy of take `i` under `condition` (see [`CONDITIONS`]):
-/// random noise alone, spikes (from other takes) on top of random noise, or
-/// spikes alone.
-fn make_noisy(takes: &[Take], i: usize, condition: usize, options: &EvalOptions) -> Result<Motion> {
+/// The noisy copy of take `i` of `takes` under `condition` (an index into
+/// [`CONDITIONS`]): random noise alone, spikes (from other takes) on top of
+/// random noise, or spikes alone; seeded by [`EvalOptions::seed`], the take
+/// and the condition, so studies can draw the evaluation's noise again.
+pub fn make_noisy(
+    takes: &[Take],
+    i: usize,
+    condition: usize,
+    options: &EvalOptions,
+) -> Result<Motion> {
     let mut rng = rng_for(options.seed, i, condition);
     let clean = &takes[i].motion;
     let noisy = if condition == SPIKES_ONLY {
