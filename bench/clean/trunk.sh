@@ -1,8 +1,8 @@
 #!/bin/bash
 # Spikes of the trunk (session 22; bench/results/clean.md, "Spikes of the trunk"): where spike finding loses
-# against the oracle and which joints' spikes it misses (spike_attribution, 120 validation takes, about 4 min),
+# against the oracle and which joints' spikes it misses (spike_attribution, 120 validation takes, about 3 min),
 # the 116-take evaluation with the default finder (trunk joints judged by their subtree's jump alone; clean_eval
-# --despike, about 5 min), and the spike figures over six noise draws of the test takes (spike_draws, about 3 min).
+# --despike, about 5 min), and the spike figures over six noise draws of the test takes (spike_draws, about 4 min).
 # Binaries: CARGO_TARGET_DIR=target-clean cargo build --profile test -p mocap-clean --examples
 set -e
 cd "$(dirname "$0")/../.."

@@ -38,14 +38,8 @@ fn relation(
     found: &FoundSpike,
     truth: &[FoundSpike],
 ) -> (usize, Option<usize>) {
-    let overlap = |a: &FoundSpike, s: &FoundSpike| {
-        let lo = a.start.max(s.start);
-        let hi = (a.start + a.frames).min(s.start + s.frames);
-        let union = (a.start + a.frames).max(s.start + s.frames) - a.start.min(s.start);
-        hi.saturating_sub(lo) as f64 / union.max(1) as f64
-    };
     for (i, s) in truth.iter().enumerate() {
-        if overlap(found, s) < 0.5 {
+        if support::overlap(found, s) < 0.5 {
             continue;
         }
         if found.joint == s.joint {

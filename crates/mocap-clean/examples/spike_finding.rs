@@ -276,12 +276,6 @@ fn sort_spikes(
     let found = find_spikes(looked_at, options);
     let related =
         |a: usize, b: usize| skeleton.subtree(a).contains(&b) || skeleton.subtree(b).contains(&a);
-    let overlap = |a: &FoundSpike, s: &FoundSpike| {
-        let lo = a.start.max(s.start);
-        let hi = (a.start + a.frames).min(s.start + s.frames);
-        let union = (a.start + a.frames).max(s.start + s.frames) - a.start.min(s.start);
-        hi.saturating_sub(lo) as f64 / union.max(1) as f64
-    };
     let mut matched = vec![false; found.len()];
     let jump = normalised_jumps(looked_at, options.span, options.global);
     let joint_count = skeleton.joint_count();
@@ -306,7 +300,7 @@ fn sort_spikes(
             }
             let mut category = "";
             for (m, f) in found.iter().enumerate() {
-                if overlap(f, s) >= 0.5 {
+                if support::overlap(f, s) >= 0.5 {
                     if f.joint == s.joint {
                         matched[m] = true;
                         category = "found";

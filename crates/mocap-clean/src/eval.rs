@@ -193,14 +193,20 @@ fn rng_for(seed: u64, take: usize, condition: usize) -> ChaCha8Rng {
 
 /// The noisy copy of take `i` of `takes` under `condition` (an index into
 /// [`CONDITIONS`]): random noise alone, spikes (from other takes) on top of
-/// random noise, or spikes alone; seeded by [`EvalOptions::seed`], the take
-/// and the condition, so studies can draw the evaluation's noise again.
-pub fn make_noisy(
+/// random noise, or spikes alone.
+fn make_noisy(takes: &[Take], i: usize, condition: usize, options: &EvalOptions) -> Result<Motion> {
+    Ok(noisy_take(takes, i, condition, options)?.0)
+}
+
+/// [`make_noisy`]'s take with the spikes it was given, seeded by
+/// [`EvalOptions::seed`], the take and the condition, so that studies can
+/// draw the evaluation's noise again.
+pub fn noisy_take(
     takes: &[Take],
     i: usize,
     condition: usize,
     options: &EvalOptions,
-) -> Result<Motion> {
+) -> Result<(Motion, Vec<Spike>)> {
     let mut rng = rng_for(options.seed, i, condition);
     let clean = &takes[i].motion;
     let noisy = if condition == SPIKES_ONLY {
@@ -209,14 +215,14 @@ pub fn make_noisy(
         add_random_noise(clean, &options.random, &mut rng).0
     };
     if condition == 0 {
-        return Ok(noisy);
+        return Ok((noisy, Vec::new()));
     }
     let donors = donor_windows(takes, i, clean.frame_count(), &mut rng);
     let refs: Vec<&Motion> = donors.iter().collect();
     if refs.is_empty() {
-        return Ok(noisy);
+        return Ok((noisy, Vec::new()));
     }
-    Ok(add_spike_noise(&noisy, &refs, &options.spikes, &mut rng)?.0)
+    add_spike_noise(&noisy, &refs, &options.spikes, &mut rng)
 }
 
 /// Donor motions as long as `frames` from other takes (looped when shorter).

@@ -98,3 +98,13 @@ pub fn spiked_take(takes: &[Take], i: usize, sigma_deg: Option<f32>) -> SpikedTa
         spikes,
     }
 }
+
+/// The frames two spikes share over the frames either covers (intersection
+/// over union): how the spike studies match a found spike to a true one.
+#[allow(dead_code)] // not every study matches spikes
+pub fn overlap(a: &mocap_clean::despike::FoundSpike, b: &mocap_clean::despike::FoundSpike) -> f64 {
+    let shared_start = a.start.max(b.start);
+    let shared_end = (a.start + a.frames).min(b.start + b.frames);
+    let union = (a.start + a.frames).max(b.start + b.frames) - a.start.min(b.start);
+    shared_end.saturating_sub(shared_start) as f64 / union.max(1) as f64
+}
