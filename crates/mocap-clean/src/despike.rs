@@ -75,7 +75,8 @@ pub struct DespikeOptions {
     /// also by its own. A spike there swaps several limbs, which jump, but
     /// the trunk joint itself often turns little: both the take and the
     /// motion it was swapped with stand upright (bench/results/clean.md,
-    /// "Spikes of the trunk").
+    /// "Spikes of the trunk"). On by default since session 22; settings
+    /// written before then read it as off, which is how they ran.
     #[serde(default)]
     pub trunk_by_subtree: bool,
 }
