@@ -198,9 +198,10 @@ fn make_noisy(takes: &[Take], i: usize, condition: usize, options: &EvalOptions)
     Ok(noisy_take(takes, i, condition, options)?.0)
 }
 
-/// [`make_noisy`]'s take with the spikes it was given, seeded by
-/// [`EvalOptions::seed`], the take and the condition, so that studies can
-/// draw the evaluation's noise again.
+/// The evaluation's noisy copy of take `i` of `takes` under `condition` (an
+/// index into [`CONDITIONS`]), with the spikes it was given (none for random
+/// noise alone); seeded by [`EvalOptions::seed`], the take and the
+/// condition, so that studies can draw the evaluation's noise again.
 pub fn noisy_take(
     takes: &[Take],
     i: usize,
