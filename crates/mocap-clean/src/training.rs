@@ -367,7 +367,7 @@ impl<'a> WindowSampler<'a> {
         self
     }
 
-    /// [`WindowSampler::with_base`] for a classical filter at `fps`.
+    /// The sampler with a classical filter at `fps` as its base (see `with_base`).
     pub fn with_base_filter(self, base: Option<Filter>, fps: f32, context: usize) -> Self {
         self.with_base(base.map(|f| Base::Classical(f, fps)), context)
     }
