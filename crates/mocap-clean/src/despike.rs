@@ -26,8 +26,8 @@
 //!    subtree branches into several limbs) needs only its subtree's jump
 //!    ([`DespikeOptions::trunk_by_subtree`]): a spike there swaps several
 //!    limbs at once, while the trunk itself, upright in both motions, often
-//!    hardly jumps, and a joint's own jump alone would pass such spikes
-//!    down to single limbs, whose boundaries then rarely pair. The root
+//!    hardly jumps; asking it for its own jump too passed such spikes down
+//!    to single limbs, whose boundaries then rarely paired. The root
 //!    never is a boundary, nor a joint with no rotating joint below it (its
 //!    own jump is all there is to go by: a toe that rests and then moves
 //!    would do);
