@@ -143,14 +143,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 rotation_error_deg(clean, &model.clean(m, None).expect("clean")) * n as f64
             };
             let error = |list: &[FoundSpike]| error_of(&bridge_spikes(&spiked, list));
-            let truth: Vec<FoundSpike> = spikes
-                .iter()
-                .map(|s| FoundSpike {
-                    joint: s.joint,
-                    start: s.start,
-                    frames: s.frames,
-                })
-                .collect();
+            let truth: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
             // No finding, the oracle, the oracle anchored, no spikes at all,
             // then the default finder at other thresholds.
             let mut shared = vec![

@@ -92,14 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     cutoff_hz: 2.0,
                 });
                 row[3] = filtered(Filter::ButterworthGcv { order: 2 });
-                let truth: Vec<FoundSpike> = spikes
-                    .iter()
-                    .map(|s| FoundSpike {
-                        joint: s.joint,
-                        start: s.start,
-                        frames: s.frames,
-                    })
-                    .collect();
+                let truth: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
                 row[8] = error(
                     &model
                         .clean(&bridge_spikes(&spiked, &truth), None)

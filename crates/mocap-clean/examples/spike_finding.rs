@@ -146,14 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     rotation_error_deg(clean, &out) * n as f64
                 })
                 .collect();
-            let truth: Vec<FoundSpike> = spikes
-                .iter()
-                .map(|s| FoundSpike {
-                    joint: s.joint,
-                    start: s.start,
-                    frames: s.frames,
-                })
-                .collect();
+            let truth: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
             let oracle = model
                 .clean(&bridge_spikes(&spiked, &truth), None)
                 .expect("clean");

@@ -44,7 +44,6 @@ use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::features::{FeatureLayout, Representation};
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::Spike;
 use mocap_clean::wiener::WienerFilter;
 use mocap_core::Motion;
 use rayon::prelude::*;
@@ -101,20 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 } = support::spiked_take(&takes, i, level);
                 let clean = &takes[i].motion;
                 let n = clean.frame_count();
-                let found: Vec<FoundSpike> = spikes
-                    .iter()
-                    .map(
-                        |&Spike {
-                             joint,
-                             start,
-                             frames,
-                         }| FoundSpike {
-                            joint,
-                            start,
-                            frames,
-                        },
-                    )
-                    .collect();
+                let found: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
                 let bridged = bridge_spikes(&spiked, &found);
                 let layout =
                     FeatureLayout::new(clean.skeleton(), Representation::Rot6d).expect("rig");

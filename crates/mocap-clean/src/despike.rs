@@ -106,6 +106,18 @@ pub struct FoundSpike {
     pub frames: usize,
 }
 
+/// A spike the noise put in, as a found one would be (for bridging the true
+/// spikes, an oracle, and for matching found spikes against them).
+impl From<crate::noise::Spike> for FoundSpike {
+    fn from(spike: crate::noise::Spike) -> Self {
+        FoundSpike {
+            joint: spike.joint,
+            start: spike.start,
+            frames: spike.frames,
+        }
+    }
+}
+
 /// The spikes of `motion` (see the module docs), in order of joint, then
 /// start.
 pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike> {
