@@ -2,6 +2,7 @@
 //!
 //! cargo run --release -p mocap-clean --example clean_speed -- --data ../shared/data/bandai \
 //!     [--model FILE (a network or a Wiener filter)] [--base-wiener FILE] [--device cpu|cuda] [--frames 1800] [--repeats 5] [--train-steps 5] [--batch 512]
+//!     [--level-estimate segment-median|pooled]
 //!
 //! `--base-wiener`: the Wiener filter file a model on a Wiener base was trained with (its training
 //! speed needs it; the model file carries only what cleaning needs).
@@ -19,6 +20,7 @@ use std::time::Instant;
 use mocap_clean::dataset::list_bvh;
 use mocap_clean::infer::{CleanModel, ModelFile};
 use mocap_clean::training::{train, TrainOptions};
+use mocap_clean::wiener::LevelEstimate;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::Motion;
 
@@ -28,6 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut frames, mut repeats, mut train_steps, mut batch) =
         (1800usize, 5usize, 5usize, 512usize);
     let mut base_wiener = None;
+    let mut level_estimate = LevelEstimate::default();
     let mut i = 0;
     while i < args.len() {
         let v = args
@@ -43,6 +46,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--repeats" => repeats = v.parse()?,
             "--train-steps" => train_steps = v.parse()?,
             "--batch" => batch = v.parse()?,
+            "--level-estimate" => {
+                level_estimate = match v.as_str() {
+                    "segment-median" => LevelEstimate::SegmentMedian,
+                    "pooled" => LevelEstimate::Pooled,
+                    _ => {
+                        return Err(format!("--level-estimate {v}: segment-median or pooled").into())
+                    }
+                }
+            }
             other => return Err(format!("unknown option {other}").into()),
         }
         i += 2;
@@ -51,10 +63,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // What a user waits for before the first frame: reading the model and
     // building its filter's bases.
     let start = Instant::now();
-    let model = match &model_path {
+    let mut model = match &model_path {
         Some(p) => ModelFile::load(p, device)?,
         None => ModelFile::Network(Box::new(CleanModel::load_default(device)?)),
     };
+    match &mut model {
+        ModelFile::Network(m) => m.set_level_estimate(level_estimate),
+        ModelFile::Wiener(w) => w.set_level_estimate(level_estimate),
+    }
     let load_seconds = start.elapsed().as_secs_f64();
     // A long clip: takes joined end to end on the first take's skeleton.
     let paths = list_bvh(std::slice::from_ref(&data))?;

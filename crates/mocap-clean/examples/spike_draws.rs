@@ -16,7 +16,8 @@
 //!
 //! cargo run --profile test -p mocap-clean --example spike_draws -- DATA [SEEDS]
 
-use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split};
+mod support;
+
 use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions, FoundSpike};
 use mocap_clean::eval::{noisy_take, rotation_error_deg, EvalOptions};
 use mocap_clean::filters::{filter_motion, Filter};
@@ -31,17 +32,11 @@ use rayon::prelude::*;
 const COLUMNS: usize = 10;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
-    let data = args.next().ok_or("DATA folder needed")?;
-    let seeds: Vec<u64> = args
-        .next()
-        .unwrap_or_else(|| "7,8,9,10,11,12".to_string())
-        .split(',')
-        .map(str::parse)
-        .collect::<Result<_, _>>()?;
-    let paths = paths_in_split(&list_bvh(&[data.into()])?, Split::Test, &Default::default());
-    let takes = load_takes(&paths)?;
-    let frames: usize = takes.iter().map(|t| t.motion.frame_count()).sum();
+    let support::TestDraws {
+        takes,
+        frames,
+        seeds,
+    } = support::test_draws()?;
     let model = CleanModel::load_default(Default::default())?;
     let finders = [
         DespikeOptions::default(),

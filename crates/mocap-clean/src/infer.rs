@@ -35,7 +35,7 @@ use crate::training::{
     base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
     CHECKPOINT_KIND_VERSION,
 };
-use crate::wiener::{WienerFilter, WienerOutcome, WIENER_KIND};
+use crate::wiener::{LevelEstimate, WienerFilter, WienerOutcome, WIENER_KIND};
 use crate::{CleanError, Result};
 
 /// Where the shipped default model lives in the source tree.
@@ -371,6 +371,14 @@ impl CleanModel {
     /// ([`ModelDescription::base_wiener`]).
     pub fn base_wiener(&self) -> Option<&WienerFilter> {
         self.base_wiener.as_ref()
+    }
+
+    /// Sets how the Wiener filter the network corrects estimates a take's
+    /// noise level (nothing to set for a model without one).
+    pub fn set_level_estimate(&mut self, estimate: LevelEstimate) {
+        if let Some(wiener) = &mut self.base_wiener {
+            wiener.set_level_estimate(estimate);
+        }
     }
 
     /// The same network correcting another Wiener filter: one with the same

@@ -200,6 +200,49 @@ fn the_shipped_model_leaves_clean_held_out_takes_nearly_alone() {
 }
 
 #[test]
+fn spikes_do_not_raise_the_noise_level_the_shipped_model_reads() {
+    // Takes with spikes and no other noise (the evaluation's spikes-alone
+    // condition, its seed), not bridged. With the level of all segments
+    // together (sessions 7-22) the spiked segments raise the level of the
+    // whole take and the model smooths all of it; the median of the
+    // segments' levels (the default) keeps to the rest of the take.
+    use mocap_clean::eval::{noisy_take, EvalOptions};
+    use mocap_clean::wiener::LevelEstimate;
+    let Some((median_model, test)) = shipped_model_and_test_takes() else {
+        return;
+    };
+    let mut pooled_model = CleanModel::load_default(Default::default()).unwrap();
+    pooled_model.set_level_estimate(LevelEstimate::Pooled);
+    let takes = mocap_clean::dataset::load_takes(&test).unwrap();
+    let spikes_alone = 2;
+    let (mut error, mut level, mut frames) = ([0.0; 2], [0.0; 2], 0.0);
+    for i in 0..takes.len() {
+        let clean = &takes[i].motion;
+        let spiked = noisy_take(&takes, i, spikes_alone, &EvalOptions::default())
+            .unwrap()
+            .0;
+        for (k, model) in [&pooled_model, &median_model].into_iter().enumerate() {
+            let (out, estimated) = model.clean_reporting(&spiked, None).unwrap();
+            error[k] += rotation_error_deg(clean, &out) * clean.frame_count() as f64;
+            level[k] += estimated.unwrap() / takes.len() as f64;
+        }
+        frames += clean.frame_count() as f64;
+    }
+    let error = error.map(|e| e / frames);
+    eprintln!(
+        "{} takes with spikes alone: pooled level {:.2} deg, error {:.3}; median level {:.2} deg, \
+         error {:.3}",
+        takes.len(),
+        level[0],
+        error[0],
+        level[1],
+        error[1]
+    );
+    assert!(level[1] < 0.6 * level[0], "levels {level:?}");
+    assert!(error[1] < 0.9 * error[0], "errors {error:?}");
+}
+
+#[test]
 fn spike_finding_leaves_clean_held_out_takes_nearly_alone() {
     // `mocap clean --despike` bridges what it takes for spikes before the
     // model runs; on clean takes whatever it finds is a false alarm. Measured

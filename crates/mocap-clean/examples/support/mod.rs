@@ -19,6 +19,7 @@ pub struct StudyArgs {
     pub rest: Vec<String>,
 }
 
+#[allow(dead_code)] // not every study takes these arguments
 pub fn parse() -> Result<StudyArgs, Box<dyn Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let data = PathBuf::from(args.first().ok_or("DATA folder needed")?);
@@ -107,4 +108,38 @@ pub fn overlap(a: &mocap_clean::despike::FoundSpike, b: &mocap_clean::despike::F
     let shared_end = (a.start + a.frames).min(b.start + b.frames);
     let union = (a.start + a.frames).max(b.start + b.frames) - a.start.min(b.start);
     shared_end.saturating_sub(shared_start) as f64 / union.max(1) as f64
+}
+
+/// The test takes of a study that draws the evaluation's noise again, and
+/// the seeds of its draws.
+#[allow(dead_code)] // not every study draws the evaluation's noise
+pub struct TestDraws {
+    pub takes: Vec<Take>,
+    /// Frames of all the takes.
+    pub frames: usize,
+    pub seeds: Vec<u64>,
+}
+
+/// The command line of the studies that draw the evaluation's noise again,
+/// `DATA [SEEDS]` (seeds comma-separated, default 7-12, 7 being the
+/// evaluation's own), with the test takes of `DATA` (the training code's
+/// split by take).
+#[allow(dead_code)] // not every study draws the evaluation's noise
+pub fn test_draws() -> Result<TestDraws, Box<dyn Error>> {
+    let mut args = std::env::args().skip(1);
+    let data = PathBuf::from(args.next().ok_or("DATA folder needed")?);
+    let seeds: Vec<u64> = args
+        .next()
+        .unwrap_or_else(|| "7,8,9,10,11,12".to_string())
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()?;
+    let paths = paths_in_split(&list_bvh(&[data])?, Split::Test, &SplitFractions::default());
+    let takes = load_takes(&paths)?;
+    let frames = takes.iter().map(|t| t.motion.frame_count()).sum();
+    Ok(TestDraws {
+        takes,
+        frames,
+        seeds,
+    })
 }
