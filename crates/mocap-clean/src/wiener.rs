@@ -121,9 +121,18 @@ pub const WIENER_KIND_VERSION: u32 = 1;
 /// (about 140 frames' worth; see "Mixture" in the module docs).
 const CHOICE_SEGMENTS: usize = 8;
 
-/// The noise levels (degrees) the marginal likelihood (2) is evaluated at.
+/// The noise levels (degrees) the marginal likelihood (2) is evaluated at:
+/// every 0.1 degree from 0.05 to 30.05, and below 0.05 a few levels down to
+/// 0.0005, so that a clean segment can be told that it is clean: the filter
+/// passes what the clean spectra hold, and at 0.05 degrees it still damps
+/// the frequencies where they hold almost nothing (the model moved clean
+/// test takes by 0.062 degrees on average with the grid starting at 0.05,
+/// 0.043 with these; `bench/results/clean.md`, "A noise level robust to
+/// spikes").
 fn sigma_grid_deg() -> impl Iterator<Item = f64> {
-    (0..=300).map(|i| 0.05 + 0.1 * i as f64)
+    [0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.03, 0.04]
+        .into_iter()
+        .chain((0..=300).map(|i| 0.05 + 0.1 * i as f64))
 }
 
 /// The median of `values` (the mean of the middle two for an even count; 0
