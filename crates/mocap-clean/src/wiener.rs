@@ -250,13 +250,13 @@ struct Whitening {
     noisy: DMatrix<f64>,
 }
 
-/// (2) for one segment at every level of the grid, as a table: `log L(s)`
-/// is `-sum w ln(lambda + s) - sum w p / (lambda + s)` over the bins'
-/// coordinates (weights `w` of 1/2 at the real frequencies), so the first
-/// sum and the factors `w / (lambda + s)` are the same for every segment of
-/// a take and are computed once, leaving a product per level and segment
-/// (the median estimate evaluates (2) for every segment, where the pooled
-/// one does it once).
+/// (2) at every level of the grid, as a table: over `n` segments whose
+/// powers sum to `p`, `log L(s)` is `-n sum w ln(lambda + s) - sum w p /
+/// (lambda + s)` over the bins' coordinates (weights `w` of 1/2 at the real
+/// frequencies), so the first sum and the factors `w / (lambda + s)` depend
+/// on the component alone. Built once per take, they leave a product per
+/// level and segment where the median estimate evaluates (2) for every
+/// segment.
 struct LevelTable {
     sigmas: Vec<f64>,
     /// Per level: `sum w ln(lambda + s)`.
@@ -303,9 +303,10 @@ impl LevelTable {
         }
     }
 
-    /// The level of largest likelihood (2) of one segment of power `power`
-    /// ([`WienerFilter::segment_power`]).
-    fn most_likely_level(&self, power: &[Vec<f64>]) -> f64 {
+    /// The level of largest likelihood (2) of `n` segments whose powers
+    /// ([`WienerFilter::segment_power`]) sum to `power`, and that
+    /// log-likelihood.
+    fn most_likely_level(&self, power: &[Vec<f64>], n: f64) -> (f64, f64) {
         let flat: Vec<f64> = power.iter().flatten().copied().collect();
         self.sigmas
             .iter()
@@ -313,10 +314,10 @@ impl LevelTable {
             .zip(&self.inverse_terms)
             .map(|((&sigma, logs), inverses)| {
                 let fit: f64 = inverses.iter().zip(&flat).map(|(a, p)| a * p).sum();
-                (sigma, -logs - fit)
+                (sigma, -n * logs - fit)
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(0.0, |(sigma, _)| sigma)
+            .unwrap_or((0.0, 0.0))
     }
 }
 
@@ -1085,30 +1086,6 @@ impl WienerFilter {
             .collect()
     }
 
-    /// The level of largest likelihood (2) of `n` segments whose powers sum
-    /// to `power`, and that log-likelihood.
-    fn most_likely_level(&self, component: &Component, power: &[Vec<f64>], n: f64) -> (f64, f64) {
-        let len = self.description.segment;
-        let log_likelihood = |s: f64| -> f64 {
-            let mut total = 0.0;
-            for (b, (bin, p)) in component.level_bins.iter().zip(power).enumerate() {
-                let weight = if b == 0 || 2 * b == len { 0.5 } else { 1.0 };
-                let mut sum = 0.0;
-                for (&l, &pi) in bin.noisy_lambda.iter().zip(p) {
-                    let v = l + s;
-                    sum += -n * v.ln() - pi / v;
-                }
-                total += weight * sum;
-            }
-            total
-        };
-        let reference = self.description.noise_sigma_deg as f64;
-        sigma_grid_deg()
-            .map(|sigma| (sigma, log_likelihood((sigma / reference).powi(2))))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .unwrap_or((0.0, 0.0))
-    }
-
     /// The noise level of largest marginal likelihood (2) over all the
     /// segments `spectra` together, and that log-likelihood.
     fn estimate_level(
@@ -1139,7 +1116,7 @@ impl WienerFilter {
             .par_iter()
             .map(|x| self.segment_power(component, x, norm))
             .reduce(empty, add);
-        self.most_likely_level(component, &power, spectra.len() as f64)
+        LevelTable::new(self, component).most_likely_level(&power, spectra.len() as f64)
     }
 
     /// The take's noise level from its segments `spectra`, as
@@ -1152,7 +1129,11 @@ impl WienerFilter {
                 let table = LevelTable::new(self, component);
                 let mut levels: Vec<f64> = spectra
                     .par_iter()
-                    .map(|x| table.most_likely_level(&self.segment_power(component, x, norm)))
+                    .map(|x| {
+                        table
+                            .most_likely_level(&self.segment_power(component, x, norm), 1.0)
+                            .0
+                    })
                     .collect();
                 median(&mut levels)
             }
