@@ -231,12 +231,14 @@ struct LevelBin {
 /// them, but only the chosen one's bases for (1), the larger part of the
 /// work (a full-size eigendecomposition and products per bin): they are
 /// built the first time the component is chosen, so that loading a
-/// mixture stays quick.
+/// mixture stays quick. The table of (2) over the grid of levels is built
+/// the first time a level is estimated with the component.
 #[derive(Debug, Clone)]
 struct Component {
     spectra: Vec<DMatrix<C64>>,
     level_bins: Vec<LevelBin>,
     bins: OnceLock<Vec<Bin>>,
+    level_table: OnceLock<LevelTable>,
 }
 
 /// `N`'s square root and inverse square root (with the ridge) and the
@@ -250,19 +252,22 @@ struct Whitening {
     noisy: DMatrix<f64>,
 }
 
-/// (2) at every level of the grid, as a table: over `n` segments whose
-/// powers sum to `p`, `log L(s)` is `-n sum w ln(lambda + s) - sum w p /
-/// (lambda + s)` over the bins' coordinates (weights `w` of 1/2 at the real
-/// frequencies), so the first sum and the factors `w / (lambda + s)` depend
-/// on the component alone. Built once per take, they leave a product per
-/// level and segment where the median estimate evaluates (2) for every
-/// segment.
+/// What (2) needs of a component at every level of the grid: over `n`
+/// segments whose powers sum to `p`, `log L(s)` is
+/// `-n sum w ln(lambda + s) - sum w p / (lambda + s)` over the bins'
+/// coordinates (weights `w` of 1/2 at the real frequencies). The first sum
+/// depends on the component alone and holds the logarithms, the costly
+/// part, so it is kept with the component ([`WienerFilter::level_table`]).
+#[derive(Debug, Clone)]
 struct LevelTable {
     sigmas: Vec<f64>,
+    /// `s` of each level (`(sigma / reference)^2`).
+    scales: Vec<f64>,
     /// Per level: `sum w ln(lambda + s)`.
     log_terms: Vec<f64>,
-    /// Per level, per coordinate (bins in order): `w / (lambda + s)`.
-    inverse_terms: Vec<Vec<f64>>,
+    /// Per coordinate, bins in order: `w` and `lambda`.
+    weights: Vec<f64>,
+    lambdas: Vec<f64>,
 }
 
 impl LevelTable {
@@ -279,45 +284,75 @@ impl LevelTable {
             .unzip();
         let reference = filter.description.noise_sigma_deg as f64;
         let sigmas: Vec<f64> = sigma_grid_deg().collect();
-        let (log_terms, inverse_terms) = sigmas
+        let scales: Vec<f64> = sigmas.iter().map(|s| (s / reference).powi(2)).collect();
+        let log_terms = scales
             .iter()
-            .map(|sigma| {
-                let s = (sigma / reference).powi(2);
-                let logs = weights
+            .map(|s| {
+                weights
                     .iter()
                     .zip(&lambdas)
                     .map(|(w, l)| w * (l + s).ln())
-                    .sum::<f64>();
-                let inverses = weights
-                    .iter()
-                    .zip(&lambdas)
-                    .map(|(w, l)| w / (l + s))
-                    .collect();
-                (logs, inverses)
+                    .sum()
             })
-            .unzip();
+            .collect();
         LevelTable {
             sigmas,
+            scales,
             log_terms,
-            inverse_terms,
+            weights,
+            lambdas,
         }
+    }
+
+    /// The level of largest likelihood (2) and that log-likelihood, given
+    /// `n` and, per level, the sum `fit(level)` of `w p / (lambda + s)`.
+    fn best(&self, n: f64, fit: impl Fn(usize) -> f64) -> (f64, f64) {
+        (0..self.sigmas.len())
+            .map(|g| (self.sigmas[g], -n * self.log_terms[g] - fit(g)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0.0, 0.0))
     }
 
     /// The level of largest likelihood (2) of `n` segments whose powers
     /// ([`WienerFilter::segment_power`]) sum to `power`, and that
     /// log-likelihood.
-    fn most_likely_level(&self, power: &[Vec<f64>], n: f64) -> (f64, f64) {
-        let flat: Vec<f64> = power.iter().flatten().copied().collect();
-        self.sigmas
+    fn most_likely_level(&self, power: &[f64], n: f64) -> (f64, f64) {
+        self.best(n, |g| {
+            let s = self.scales[g];
+            self.weights
+                .iter()
+                .zip(&self.lambdas)
+                .zip(power)
+                .map(|((w, l), p)| w * p / (l + s))
+                .sum()
+        })
+    }
+
+    /// The level of largest likelihood (2) of each segment of power
+    /// `powers[k]` on its own. The factors `w / (lambda + s)` are the same
+    /// for every segment: computed once here, they leave a product per
+    /// level and segment.
+    fn segment_levels(&self, powers: &[Vec<f64>]) -> Vec<f64> {
+        let factors: Vec<Vec<f64>> = self
+            .scales
             .iter()
-            .zip(&self.log_terms)
-            .zip(&self.inverse_terms)
-            .map(|((&sigma, logs), inverses)| {
-                let fit: f64 = inverses.iter().zip(&flat).map(|(a, p)| a * p).sum();
-                (sigma, -n * logs - fit)
+            .map(|s| {
+                self.weights
+                    .iter()
+                    .zip(&self.lambdas)
+                    .map(|(w, l)| w / (l + s))
+                    .collect()
             })
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .unwrap_or((0.0, 0.0))
+            .collect();
+        powers
+            .par_iter()
+            .map(|power| {
+                self.best(1.0, |g| {
+                    factors[g].iter().zip(power).map(|(a, p)| a * p).sum()
+                })
+                .0
+            })
+            .collect()
     }
 }
 
@@ -336,8 +371,7 @@ pub struct WienerFilter {
 }
 
 /// How the noise level of a take is estimated from its segments by (2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LevelEstimate {
     /// The level of largest likelihood (2) of each segment on its own, and
     /// the median of those levels (the default since session 23). A few
@@ -798,6 +832,7 @@ impl WienerFilter {
                     spectra,
                     level_bins,
                     bins: OnceLock::new(),
+                    level_table: OnceLock::new(),
                 }
             })
             .collect();
@@ -830,6 +865,14 @@ impl WienerFilter {
                 })
                 .collect()
         })
+    }
+
+    /// The table of (2) of `component`, built on first use (on one thread,
+    /// as [`Self::bins`]).
+    fn level_table<'a>(&self, component: &'a Component) -> &'a LevelTable {
+        component
+            .level_table
+            .get_or_init(|| LevelTable::new(self, component))
     }
 
     /// The features of `motion`'s rig, or an error naming both rigs.
@@ -1074,14 +1117,14 @@ impl WienerFilter {
 
     /// The power of one segment's bins `x` per bin and coordinate of (2),
     /// in the noise-whitened basis of `component`'s noisy directions.
-    fn segment_power(&self, component: &Component, x: &DMatrix<C64>, norm: f64) -> Vec<Vec<f64>> {
+    fn segment_power(&self, component: &Component, x: &DMatrix<C64>, norm: f64) -> Vec<f64> {
         component
             .level_bins
             .iter()
             .enumerate()
-            .map(|(b, bin)| {
+            .flat_map(|(b, bin)| {
                 let z = &bin.noisy_to_white * x.column(b);
-                z.iter().map(|v| v.norm_sqr() / norm).collect()
+                z.iter().map(|v| v.norm_sqr() / norm).collect::<Vec<f64>>()
             })
             .collect()
     }
@@ -1097,26 +1140,21 @@ impl WienerFilter {
         // Coefficients of a window v have variance (lambda + s) sum(v^2)
         // in the units the spectra were normalised to.
         let norm: f64 = window.iter().map(|v| v * v).sum();
-        let empty = || -> Vec<Vec<f64>> {
-            component
-                .level_bins
-                .iter()
-                .map(|bin| vec![0.0; bin.noisy_lambda.len()])
-                .collect()
-        };
-        let add = |mut a: Vec<Vec<f64>>, b: Vec<Vec<f64>>| {
-            for (pa, pb) in a.iter_mut().zip(&b) {
-                for (x, y) in pa.iter_mut().zip(pb) {
-                    *x += y;
-                }
-            }
-            a
-        };
+        let coordinates = self.level_table(component).weights.len();
         let power = spectra
             .par_iter()
             .map(|x| self.segment_power(component, x, norm))
-            .reduce(empty, add);
-        LevelTable::new(self, component).most_likely_level(&power, spectra.len() as f64)
+            .reduce(
+                || vec![0.0; coordinates],
+                |mut a, b| {
+                    for (x, y) in a.iter_mut().zip(&b) {
+                        *x += y;
+                    }
+                    a
+                },
+            );
+        self.level_table(component)
+            .most_likely_level(&power, spectra.len() as f64)
     }
 
     /// The take's noise level from its segments `spectra`, as
@@ -1126,16 +1164,11 @@ impl WienerFilter {
             LevelEstimate::Pooled => self.estimate_level(component, spectra, window).0,
             LevelEstimate::SegmentMedian => {
                 let norm: f64 = window.iter().map(|v| v * v).sum();
-                let table = LevelTable::new(self, component);
-                let mut levels: Vec<f64> = spectra
+                let powers: Vec<Vec<f64>> = spectra
                     .par_iter()
-                    .map(|x| {
-                        table
-                            .most_likely_level(&self.segment_power(component, x, norm), 1.0)
-                            .0
-                    })
+                    .map(|x| self.segment_power(component, x, norm))
                     .collect();
-                median(&mut levels)
+                median(&mut self.level_table(component).segment_levels(&powers))
             }
         }
     }
@@ -1629,6 +1662,7 @@ mod tests {
                 spectra: Vec::new(),
                 level_bins,
                 bins: OnceLock::from(bins),
+                level_table: OnceLock::new(),
             }],
             noise: DMatrix::zeros(c, c),
             whitening: Arc::new(Whitening {
