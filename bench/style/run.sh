@@ -63,7 +63,7 @@ fi
   --markdown "$OUT/eval-root-source.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
 
 "$BIN/style_speed" "$DATA/dataset-1/dataset-1_walk_not-confident_001.bvh" \
-  "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 | tee "$OUT/speed.md"
+  "$DATA/dataset-1/dataset-1_walk_proud_002.bvh" --runs 20 --patches 48,32 | tee "$OUT/speed.md"
 
 if flag --contacts; then
   # The foot-contact cleanup before and after session 18, how much the feet

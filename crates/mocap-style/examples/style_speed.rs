@@ -1,7 +1,7 @@
 //! Time to restyle a 10-second clip, and the share of each stage.
 //!
 //! ```text
-//! cargo run --release -p mocap-style --example style_speed -- SOURCE STYLE_CLIP [--model M] [--runs 20]
+//! cargo run --release -p mocap-style --example style_speed -- SOURCE STYLE_CLIP [--model M] [--runs 20] [--patches 32,48]
 //! ```
 //!
 //! The source is cut (or its frames used) to its first 10 seconds; each run
@@ -9,7 +9,8 @@
 //! `mocap style apply` does (file reading and writing excluded). Prints the
 //! median of every stage over the runs, for elastic and fixed patches, the
 //! three roots, and without the source's asymmetry (which encodes the
-//! source's mirror too).
+//! source's mirror too). `--patches` repeats the elastic and fixed rows
+//! for other patch lengths (default: the default length only).
 
 use std::path::PathBuf;
 
@@ -30,16 +31,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut paths = Vec::new();
     let mut model_path = None;
     let mut runs = 20;
+    let mut patches = vec![ConvertOptions::default().patch];
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--model" => model_path = args.next().map(PathBuf::from),
             "--runs" => runs = args.next().expect("--runs N").parse()?,
+            "--patches" => {
+                patches = args
+                    .next()
+                    .expect("--patches P1,P2")
+                    .split(',')
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()?
+            }
             _ => paths.push(PathBuf::from(a)),
         }
     }
     let [source, style] = &paths[..] else {
-        return Err("usage: speed SOURCE STYLE_CLIP [--model M] [--runs N]".into());
+        return Err(
+            "usage: style_speed SOURCE STYLE_CLIP [--model M] [--runs N] [--patches P1,P2]".into(),
+        );
     };
     let model = load_model(model_path.as_deref(), DeviceChoice::Cpu)?;
     let source = read_bvh(source)?;
@@ -59,7 +71,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| method | total (ms) | prepare | encode | match | decode | compose | output frames |"
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
-    for (method, root, asymmetry) in [
+    let default_patch = ConvertOptions::default().patch;
+    // Every setting at the default patch length, then elastic and fixed
+    // patches at each other length asked for.
+    let mut settings = vec![
         (
             Method::ElasticPatches,
             RootPath::FeetAlongSource,
@@ -82,7 +97,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             RootPath::FeetAlongSource,
             Asymmetry::Style,
         ),
-    ] {
+    ]
+    .into_iter()
+    .map(|(method, root, asymmetry)| (method, root, asymmetry, default_patch))
+    .collect::<Vec<_>>();
+    for &patch in patches.iter().filter(|&&p| p != default_patch) {
+        for method in [Method::ElasticPatches, Method::FixedPatches] {
+            settings.push((method, RootPath::FeetAlongSource, Asymmetry::Source, patch));
+        }
+    }
+    for (method, root, asymmetry, patch) in settings {
         let mut all: Vec<StageTimings> = Vec::new();
         let mut out_frames = 0;
         for _ in 0..runs + 1 {
@@ -92,6 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 method,
                 root,
                 asymmetry,
+                patch,
                 ..ConvertOptions::default()
             };
             let r = restyle(&model, &source, &[(&clip, 1.0)], &options, t)?;
@@ -103,7 +128,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let total = ms(&|t| t.total());
         let share = |v: f64| format!("{v:.1} ms ({:.0}%)", 100.0 * v / total);
         println!(
-            "| {}, root {}, asymmetry {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| {}, P {patch}, root {}, asymmetry {} | {:.1} | {} | {} | {} | {} | {} | {} |",
             method.name(),
             root.name(),
             asymmetry.name(),

@@ -67,7 +67,7 @@ pub struct ApplyOptions {
     pub fade_in_seconds: f64,
     /// A second style clip and its weight in the blend (`--blend CLIP:0.5`).
     pub blend: Option<(PathBuf, f32)>,
-    /// Patch length in frames (default 32).
+    /// Patch length in frames (default 48).
     pub patch: usize,
     /// Where the root goes (default [`RootPath::FeetAlongSource`]).
     #[serde(default)]

@@ -13,9 +13,12 @@
 //!    stretch) is compared by cosine similarity with every window of `P`
 //!    frames of the whitened style sequences; the stretch and window with
 //!    the highest similarity win. A style patch keeps its `P` frames, so the
-//!    output gives `P` frames to `L` source frames: a source stride that
-//!    matches the style best when shrunk to 24 frames comes out 32 frames
-//!    long, at the style's pace. Fixed patches always take `L = P`.
+//!    output gives `P` frames to `L` source frames: with the default `P =
+//!    48`, a source stride that matches the style best when shrunk to 36
+//!    frames comes out 48 frames long, at the style's pace. Fixed patches
+//!    always take `L = P`. (The report does not give `P`; 48 was chosen on
+//!    one fold of the Bandai takes and judged on the other, 32 before
+//!    session 24: bench/results/style.md, "The patch length".)
 //! 3. Seams: a second series of patches, offset by half a patch (each from
 //!    the centre of one stretched patch to the centre of the next), is
 //!    matched too, and the two are blended with linear weights along time
@@ -282,7 +285,7 @@ impl std::str::FromStr for Method {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ConvertOptions {
     pub method: Method,
-    /// Patch length `P` in frames (even).
+    /// Patch length `P` in frames (even; default 48, 1.6 s at 30 fps).
     pub patch: usize,
     /// Largest stretch or shrink of a source patch, as a fraction of `P`
     /// (report: 0.25).
@@ -310,7 +313,7 @@ impl Default for ConvertOptions {
     fn default() -> Self {
         ConvertOptions {
             method: Method::ElasticPatches,
-            patch: 32,
+            patch: 48,
             stretch: 0.25,
             stretch_step: 4,
             strength: 1.0,
@@ -970,6 +973,8 @@ mod tests {
     #[test]
     fn patch_lengths_follow_the_report() {
         let o = ConvertOptions::default();
+        assert_eq!(o.patch_lengths(), vec![36, 40, 44, 48, 52, 56, 60]);
+        let o = ConvertOptions { patch: 32, ..o };
         assert_eq!(o.patch_lengths(), vec![24, 28, 32, 36, 40]);
         let fixed = ConvertOptions {
             method: Method::FixedPatches,
@@ -1005,7 +1010,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.latents.frames, 200);
-        let inside = (200 - 32) * 6;
+        let inside = (200 - options.patch) * 6;
         let worst = c.latents.data[..inside]
             .iter()
             .zip(&x.data)

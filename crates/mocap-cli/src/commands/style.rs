@@ -114,8 +114,8 @@ struct ApplyArgs {
     /// Blend with a second style: OTHER_STYLE_CLIP:WEIGHT.
     #[arg(long, value_name = "CLIP:WEIGHT")]
     blend: Option<String>,
-    /// Patch length in frames (default 32; even; the style clip needs at least this many).
-    /// Longer patches (48, 56) follow the style's timing more closely.
+    /// Patch length in frames (default 48; even; the style clip needs at least this many).
+    /// Longer patches follow the style's timing more closely, shorter ones (32) its timing less.
     #[arg(long)]
     patch: Option<usize>,
     /// Where the body goes: `feet-along-source` (default: the planted feet carry it within a
@@ -172,7 +172,7 @@ struct EvalArgs {
     /// Contents the style classifier trains on (comma separated; default all).
     #[arg(long, value_delimiter = ',')]
     classifier_contents: Vec<String>,
-    /// Patch length in frames (default 32; clips shorter than two patches are left out).
+    /// Patch length in frames (default 48; clips shorter than two patches are left out).
     #[arg(long)]
     patch: Option<usize>,
     /// Where the body goes, as `apply --root`.
