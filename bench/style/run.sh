@@ -89,6 +89,9 @@ if flag --contacts; then
   "$BIN/style_eval" --root-from-feet --foot-contacts --methods elastic-patches,fixed-patches --sources walk,walk-turn-left,walk-turn-right \
     --styles walk --classifier-contents "$WALKS" --json "$OUT/eval-root-from-feet-contacts.json" \
     --markdown "$OUT/eval-root-from-feet-contacts.md" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  # Every root without and with the cleanup, side by side (style.md,
+  # "Foot-contact cleanup").
+  python3 bench/style/contacts_table.py "$OUT" > "$OUT/contacts-table.md"
 fi
 
 if flag --other-fold; then
