@@ -45,15 +45,20 @@ struct TrainArgs {
     /// still falling at 30: bench/results/style.md, "Longer training").
     #[arg(long)]
     epochs: Option<usize>,
+    /// Batches per epoch (default 100); the validation loss is measured after each epoch.
     #[arg(long)]
     steps: Option<usize>,
+    /// Windows per batch (default 16, the report's).
     #[arg(long)]
     batch: Option<usize>,
-    /// Window length in frames.
+    /// Window length in frames (default 240, the report's).
     #[arg(long)]
     window: Option<usize>,
+    /// Adam's learning rate (default 1e-4, the report's).
     #[arg(long)]
     lr: Option<f64>,
+    /// Seed of the initial weights and of the windows drawn; the same seed and data give the
+    /// same model.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Weight of a loss on the feet added to the reconstruction error: flat feet of the clips
@@ -80,6 +85,7 @@ struct TrainArgs {
     /// Continue from the last checkpoint of an interrupted run.
     #[arg(long)]
     resume: bool,
+    /// Print the training report (data, losses per epoch, time) as JSON.
     #[arg(long)]
     json: bool,
 }
@@ -142,8 +148,10 @@ struct ApplyArgs {
         default_value = "source"
     )]
     asymmetry: Asymmetry,
+    /// cpu, or cuda[:N] in a build with the `cuda` feature.
     #[arg(long, default_value = "cpu")]
     device: DeviceChoice,
+    /// Print what was done (timing, patches, root, retargeting, stage times) as JSON.
     #[arg(long)]
     json: bool,
 }
