@@ -10,6 +10,8 @@
 #   METHODS=fixed-patches PATCHES=48 RUNS_DIR=/tmp/style-fixed-judges \
 #     OUT_TABLE=bench/style/out/fixed-judges.md bash bench/style/patch_judges.sh
 #                                      # METHODS: style_eval's --methods list
+#   LAST_MODEL=M1 FIRST_MODEL=M2 ...   # other models of the two folds (default: the shipped
+#                                      # model and the other fold's model of run.sh --other-fold)
 #
 # Needs the other fold's model (bash bench/style/run.sh --other-fold). The
 # per-run reports stay in ${RUNS_DIR:-/tmp/style-patch-judges}; the table
@@ -23,7 +25,8 @@ for P in ${PATCHES:-32 48}; do
     for seed in 1 2 3; do
       for fold in last first; do
         FOLD_ARGS=(--held-out "$fold")
-        [[ $fold == first ]] && FOLD_ARGS+=(--model "$FOLD_MODEL")
+        [[ $fold == first ]] && FOLD_ARGS+=(--model "${FIRST_MODEL:-$FOLD_MODEL}")
+        [[ $fold == last && -n ${LAST_MODEL:-} ]] && FOLD_ARGS+=(--model "$LAST_MODEL")
         report=$RUNS/eval-p$P-$judge-$fold-seed$seed.json
         [[ -f $report ]] && continue
         "$BIN/style_eval" "${FOLD_ARGS[@]}" --patch "$P" --methods "${METHODS:-elastic-patches}" \
