@@ -18,12 +18,10 @@
 
 use std::path::PathBuf;
 
+use mocap_search::eval::stratified_folds;
 use mocap_search::intervals::IntervalLayout;
 use mocap_search::scores::ConfusionMatrix;
 use mocap_search::{load_clips, motion_files, Forest, ForestConfig, LabelRule, NamePattern};
-use rand::rngs::Xoshiro256PlusPlus;
-use rand::seq::SliceRandom;
-use rand::SeedableRng;
 
 const N: usize = 10;
 const K: usize = 5;
@@ -89,12 +87,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| seed | {} |", methods.join(" | "));
     println!("| --- |{}", " ---: |".repeat(methods.len()));
     for seed in 1..=seeds {
-        let folds = stratified_folds(&labels, classes.len(), K, seed);
+        // The evaluation's own deal of the clips to the folds.
+        let folds = stratified_folds(&labels, classes.len(), K, seed)?;
         let mut confusion: Vec<ConfusionMatrix> = (0..methods.len())
             .map(|_| ConfusionMatrix::new(classes.len()))
             .collect();
-        for (f, test) in folds.iter().enumerate() {
-            let train: Vec<usize> = (0..rows.len()).filter(|i| !test.contains(i)).collect();
+        for (f, fold) in folds.iter().enumerate() {
+            let (train, test) = (&fold.train, &fold.test);
             let config = ForestConfig {
                 seed: seed * 1000 + f as u64,
                 ..ForestConfig::default()
@@ -109,7 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 train_forest(&plain_rows, dim, &train_styles, style_names.len(), &config);
             // The additive model on the training clips.
             let (mu, offsets) = additive_model(
-                &train,
+                train,
                 &rows,
                 &labels,
                 &style_of,
@@ -121,7 +120,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .flat_map(|&i| subtract(&rows[i], &offsets[style_of[i]]))
                 .collect();
             let forest = train_forest(&corrected, dim, &train_labels, classes.len(), &config);
-            let scale = feature_scale(&train, &rows);
+            let scale = feature_scale(train, &rows);
             for &i in test {
                 let truth = labels[i] as usize;
                 confusion[0].add(truth, argmax(&plain.predict(&rows[i])));
@@ -328,23 +327,4 @@ fn subtract(x: &[f32], d: &[f32]) -> Vec<f32> {
 
 fn argmax(values: &[f32]) -> usize {
     mocap_search::forest::argmax(values)
-}
-
-/// The evaluation's deal: every class's clips shuffled and dealt to the
-/// folds, each class starting where the previous one ended.
-fn stratified_folds(labels: &[u32], classes: usize, k: usize, seed: u64) -> Vec<Vec<usize>> {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut fold_of = vec![0usize; labels.len()];
-    let mut next = 0usize;
-    for class in 0..classes as u32 {
-        let mut members: Vec<usize> = (0..labels.len()).filter(|&i| labels[i] == class).collect();
-        members.shuffle(&mut rng);
-        for m in members {
-            fold_of[m] = next % k;
-            next += 1;
-        }
-    }
-    (0..k)
-        .map(|f| (0..labels.len()).filter(|&i| fold_of[i] == f).collect())
-        .collect()
 }
