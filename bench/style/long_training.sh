@@ -6,8 +6,9 @@
 #
 #   bash bench/style/long_training.sh   # about 70 min of training on the quiet 2-core machine
 #                                       # (fold first resumes run.sh --other-fold's state at
-#                                       # epoch 90), then 4 min of forest runs and 12 of conv-net
-#                                       # runs per judge seed; JUDGES="forest conv-net" by default
+#                                       # epoch 90), then about 2 min of forest runs and 12 min of
+#                                       # conv-net runs per judge seed; JUDGES="forest conv-net"
+#                                       # by default
 #
 # Needs the other fold's 90-epoch model and its training state
 # (bash bench/style/run.sh --other-fold leaves both in ${MODEL_DIR:-/tmp}).
