@@ -32,7 +32,7 @@ mod support;
 use std::time::Instant;
 
 use mocap_clean::despike::{
-    bridge_spikes, find_spikes, normalised_jumps, DespikeOptions, FoundSpike,
+    bridge_spikes, find_spikes, normalised_jumps, pair_boundaries, DespikeOptions, FoundSpike,
 };
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::infer::CleanModel;
@@ -294,34 +294,5 @@ fn find_by_evidence(
             }
         }
     }
-    let mut spikes = Vec::new();
-    for (joint, times) in boundaries.iter().enumerate() {
-        let mut i = 0;
-        while i + 1 < times.len() {
-            let (start, end) = (times[i], times[i + 1]);
-            if end - start <= max_frames {
-                spikes.push(FoundSpike {
-                    joint,
-                    start,
-                    frames: end - start,
-                });
-                i += 2;
-            } else {
-                i += 1;
-            }
-        }
-    }
-    let inside_above = |s: &FoundSpike| {
-        spikes.iter().any(|a| {
-            a.joint != s.joint
-                && subtrees[a.joint].contains(&s.joint)
-                && a.start <= s.start
-                && s.start + s.frames <= a.start + a.frames
-        })
-    };
-    spikes
-        .iter()
-        .filter(|s| !inside_above(s))
-        .copied()
-        .collect()
+    pair_boundaries(skeleton, &boundaries, max_frames)
 }

@@ -49,7 +49,7 @@
 //! part of it for noise (bench/results/clean.md).
 
 use mocap_core::rotation::{angle_between, mean_of_close, slerp};
-use mocap_core::{forward_kinematics, Motion};
+use mocap_core::{forward_kinematics, Motion, Skeleton};
 use serde::{Deserialize, Serialize};
 
 /// Settings of spike finding.
@@ -226,12 +226,25 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
             above = skeleton.joint(a).parent;
         }
     }
+    pair_boundaries(skeleton, &boundaries, options.max_frames)
+}
+
+/// Step 4 of [`find_spikes`]: each joint's boundaries (`boundaries[joint]`,
+/// frames in time order) paired in time order into spikes at most
+/// `max_frames` long, a boundary without a partner left alone, and a spike
+/// inside a spike of a joint above it dropped (it is bridged with that
+/// one). Public for studies that find boundaries another way.
+pub fn pair_boundaries(
+    skeleton: &Skeleton,
+    boundaries: &[Vec<usize>],
+    max_frames: usize,
+) -> Vec<FoundSpike> {
     let mut spikes = Vec::new();
     for (joint, times) in boundaries.iter().enumerate() {
         let mut i = 0;
         while i + 1 < times.len() {
             let (start, end) = (times[i], times[i + 1]);
-            if end - start <= options.max_frames {
+            if end - start <= max_frames {
                 spikes.push(FoundSpike {
                     joint,
                     start,
@@ -243,11 +256,10 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
             }
         }
     }
-    // A spike inside a spike of a joint above it is bridged with it.
     let inside_above = |s: &FoundSpike| {
         spikes.iter().any(|a| {
             a.joint != s.joint
-                && subtrees[a.joint].contains(&s.joint)
+                && skeleton.subtree(a.joint).contains(&s.joint)
                 && a.start <= s.start
                 && s.start + s.frames <= a.start + a.frames
         })
