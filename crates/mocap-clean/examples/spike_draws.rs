@@ -22,7 +22,6 @@ use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions, FoundSpik
 use mocap_clean::eval::{noisy_take, rotation_error_deg, EvalOptions};
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
-use rayon::prelude::*;
 
 /// Columns: spikes on random noise (finder + model: default, sessions 9-21;
 /// Butterworth 2 Hz, cross-validated Butterworth), spikes alone (finder
@@ -66,50 +65,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             seed,
             ..EvalOptions::default()
         };
-        let sums = (0..takes.len())
-            .into_par_iter()
-            .map(|i| {
-                let clean = &takes[i].motion;
-                let weight = clean.frame_count() as f64;
-                let error = |m: &mocap_core::Motion| rotation_error_deg(clean, m) * weight;
-                let found_then_model = |spiked: &mocap_core::Motion, finder: &DespikeOptions| {
-                    let bridged = bridge_spikes(spiked, &find_spikes(spiked, finder));
-                    let cleaned = model.clean(&bridged, None).expect("clean");
-                    (error(&bridged), error(&cleaned))
-                };
-                let mut row = [0.0f64; COLUMNS];
-                let (spiked, spikes) = noisy_take(&takes, i, 1, &options).expect("noise");
-                row[0] = found_then_model(&spiked, &finders[0]).1;
-                row[1] = found_then_model(&spiked, &finders[1]).1;
-                let filtered = |f: Filter| error(&filter_motion(&spiked, &f).expect("filter"));
-                row[2] = filtered(Filter::Butterworth {
-                    order: 2,
-                    cutoff_hz: 2.0,
-                });
-                row[3] = filtered(Filter::ButterworthGcv { order: 2 });
-                let truth: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
-                row[8] = error(
-                    &model
-                        .clean(&bridge_spikes(&spiked, &truth), None)
-                        .expect("clean"),
-                );
-                let alone = noisy_take(&takes, i, 2, &options).expect("noise").0;
-                row[9] =
-                    error(&filter_motion(&alone, &Filter::Median { window: 3 }).expect("filter"));
-                (row[4], row[6]) = found_then_model(&alone, &finders[0]);
-                (row[5], row[7]) = found_then_model(&alone, &finders[1]);
-                row
-            })
-            .reduce(
-                || [0.0; COLUMNS],
-                |mut a, b| {
-                    for (x, y) in a.iter_mut().zip(b) {
-                        *x += y;
-                    }
-                    a
-                },
+        let mean = support::mean_over_takes(takes.len(), frames, COLUMNS, |i| {
+            let clean = &takes[i].motion;
+            let weight = clean.frame_count() as f64;
+            let error = |m: &mocap_core::Motion| rotation_error_deg(clean, m) * weight;
+            let found_then_model = |spiked: &mocap_core::Motion, finder: &DespikeOptions| {
+                let bridged = bridge_spikes(spiked, &find_spikes(spiked, finder));
+                let cleaned = model.clean(&bridged, None).expect("clean");
+                (error(&bridged), error(&cleaned))
+            };
+            let mut row = [0.0f64; COLUMNS];
+            let (spiked, spikes) = noisy_take(&takes, i, 1, &options).expect("noise");
+            row[0] = found_then_model(&spiked, &finders[0]).1;
+            row[1] = found_then_model(&spiked, &finders[1]).1;
+            let filtered = |f: Filter| error(&filter_motion(&spiked, &f).expect("filter"));
+            row[2] = filtered(Filter::Butterworth {
+                order: 2,
+                cutoff_hz: 2.0,
+            });
+            row[3] = filtered(Filter::ButterworthGcv { order: 2 });
+            let truth: Vec<FoundSpike> = spikes.iter().map(|&s| FoundSpike::from(s)).collect();
+            row[8] = error(
+                &model
+                    .clean(&bridge_spikes(&spiked, &truth), None)
+                    .expect("clean"),
             );
-        let mean: Vec<f64> = sums.iter().map(|s| s / frames as f64).collect();
+            let alone = noisy_take(&takes, i, 2, &options).expect("noise").0;
+            row[9] = error(&filter_motion(&alone, &Filter::Median { window: 3 }).expect("filter"));
+            (row[4], row[6]) = found_then_model(&alone, &finders[0]);
+            (row[5], row[7]) = found_then_model(&alone, &finders[1]);
+            row.to_vec()
+        });
         for (p, m) in pooled.iter_mut().zip(&mean) {
             *p += m / seeds.len() as f64;
         }

@@ -32,7 +32,8 @@ mod support;
 use std::time::Instant;
 
 use mocap_clean::despike::{
-    bridge_spikes, find_spikes, normalised_jumps, pair_boundaries, DespikeOptions, FoundSpike,
+    bridge_spikes, find_spikes, normalised_jumps, pair_boundaries, rotating_subtrees,
+    DespikeOptions, FoundSpike,
 };
 use mocap_clean::eval::rotation_error_deg;
 use mocap_clean::infer::CleanModel;
@@ -167,53 +168,40 @@ fn test_draws() -> Result<(), Box<dyn std::error::Error>> {
             seed,
             ..Default::default()
         };
-        let sums = (0..takes.len())
-            .into_par_iter()
-            .map(|i| {
-                let clean = &takes[i].motion;
-                let weight = clean.frame_count() as f64;
-                let error = |m: &Motion| rotation_error_deg(clean, m) * weight;
-                let mut row = vec![0.0f64; columns];
-                for kind in 0..3 {
-                    let (noisy, _) =
-                        mocap_clean::eval::noisy_take(&takes, i, kind, &options).expect("noise");
-                    let jumps = normalised_jumps(&noisy, 1, true);
-                    let mut found = vec![find_spikes(&noisy, &DespikeOptions::default())];
-                    found.extend(
-                        settings
-                            .iter()
-                            .map(|e| find_by_evidence(&noisy, &jumps, e, 90)),
-                    );
-                    for (f, list) in found.iter().enumerate() {
-                        let bridged = bridge_spikes(&noisy, list);
-                        row[kind * finders + f] =
-                            error(&model.clean(&bridged, None).expect("clean"));
-                        if kind == 2 {
-                            row[3 * finders + f] = error(&bridged);
-                        }
-                    }
-                    if kind == 1 {
-                        row[columns - 1] = error(
-                            &mocap_clean::filters::filter_motion(
-                                &noisy,
-                                &mocap_clean::filters::Filter::ButterworthGcv { order: 2 },
-                            )
-                            .expect("filter"),
-                        );
+        let mean = support::mean_over_takes(takes.len(), frames, columns, |i| {
+            let clean = &takes[i].motion;
+            let weight = clean.frame_count() as f64;
+            let error = |m: &Motion| rotation_error_deg(clean, m) * weight;
+            let mut row = vec![0.0f64; columns];
+            for kind in 0..3 {
+                let (noisy, _) =
+                    mocap_clean::eval::noisy_take(&takes, i, kind, &options).expect("noise");
+                let jumps = normalised_jumps(&noisy, 1, true);
+                let mut found = vec![find_spikes(&noisy, &DespikeOptions::default())];
+                found.extend(
+                    settings
+                        .iter()
+                        .map(|e| find_by_evidence(&noisy, &jumps, e, 90)),
+                );
+                for (f, list) in found.iter().enumerate() {
+                    let bridged = bridge_spikes(&noisy, list);
+                    row[kind * finders + f] = error(&model.clean(&bridged, None).expect("clean"));
+                    if kind == 2 {
+                        row[3 * finders + f] = error(&bridged);
                     }
                 }
-                row
-            })
-            .reduce(
-                || vec![0.0; columns],
-                |mut a, b| {
-                    for (x, y) in a.iter_mut().zip(b) {
-                        *x += y;
-                    }
-                    a
-                },
-            );
-        let mean: Vec<f64> = sums.iter().map(|s| s / frames as f64).collect();
+                if kind == 1 {
+                    row[columns - 1] = error(
+                        &mocap_clean::filters::filter_motion(
+                            &noisy,
+                            &mocap_clean::filters::Filter::ButterworthGcv { order: 2 },
+                        )
+                        .expect("filter"),
+                    );
+                }
+            }
+            row
+        });
         for (p, m) in pooled.iter_mut().zip(&mean) {
             *p += m / seeds.len() as f64;
         }
@@ -248,20 +236,7 @@ fn find_by_evidence(
     if frames < 3 {
         return Vec::new();
     }
-    let rotates: Vec<bool> = skeleton
-        .joints()
-        .iter()
-        .map(|j| j.has_rotation_channels())
-        .collect();
-    let subtrees: Vec<Vec<usize>> = (0..n)
-        .map(|j| {
-            skeleton
-                .subtree(j)
-                .into_iter()
-                .filter(|&k| rotates[k])
-                .collect()
-        })
-        .collect();
+    let subtrees = rotating_subtrees(skeleton);
     let candidate: Vec<bool> = (0..n)
         .map(|j| skeleton.joint(j).parent.is_some() && subtrees[j].len() >= 2)
         .collect();

@@ -130,21 +130,8 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
     }
     // Boundaries at frames `first..=last` (both sides have `span` frames).
     let (first, last) = (span, frames - span);
-    let rotates: Vec<bool> = skeleton
-        .joints()
-        .iter()
-        .map(|j| j.has_rotation_channels())
-        .collect();
     let jump = normalised_jumps(motion, span, options.global);
-    let subtrees: Vec<Vec<usize>> = (0..n)
-        .map(|j| {
-            skeleton
-                .subtree(j)
-                .into_iter()
-                .filter(|&k| rotates[k])
-                .collect()
-        })
-        .collect();
+    let subtrees = rotating_subtrees(skeleton);
     // Trunk joints: some joint in the subtree has two or more children
     // with rotating joints below them (a joint without channels between
     // counts as the branch it leads to).
@@ -227,6 +214,20 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
         }
     }
     pair_boundaries(skeleton, &boundaries, options.max_frames)
+}
+
+/// Each joint's subtree (itself and every joint below it), keeping only
+/// the joints with rotation channels: the joints a spike of it turns.
+pub fn rotating_subtrees(skeleton: &Skeleton) -> Vec<Vec<usize>> {
+    (0..skeleton.joint_count())
+        .map(|j| {
+            skeleton
+                .subtree(j)
+                .into_iter()
+                .filter(|&k| skeleton.joint(k).has_rotation_channels())
+                .collect()
+        })
+        .collect()
 }
 
 /// Step 4 of [`find_spikes`]: each joint's boundaries (`boundaries[joint]`,

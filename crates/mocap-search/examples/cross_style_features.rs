@@ -25,11 +25,11 @@ use std::path::PathBuf;
 
 use mocap_search::eval::stratified_folds;
 use mocap_search::forest::{argmax, Samples};
-use mocap_search::intervals::IntervalLayout;
 use mocap_search::scores::ConfusionMatrix;
-use mocap_search::{load_clips, motion_files, Forest, ForestConfig, LabelRule, NamePattern};
+use mocap_search::{Forest, ForestConfig};
 
-const N: usize = 10;
+mod support;
+
 const K: usize = 5;
 /// How many of the best-scored interval means are kept.
 const KEPT: [usize; 4] = [250, 500, 1000, 2000];
@@ -41,28 +41,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok_or("usage: cross_style_features DIR [SEEDS]")?,
     );
     let seeds: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(5);
-    let files = motion_files(&[dir])?;
-    let rule = LabelRule::FromName(NamePattern::parse("bandai-content")?);
-    let clips = load_clips(&files, &rule, false)?;
-
-    // Classes with at least two clips, as the evaluation keeps them.
-    let mut classes: Vec<String> = clips.iter().map(|c| c.label.clone()).collect();
-    classes.sort();
-    classes.dedup();
-    classes.retain(|c| clips.iter().filter(|k| &k.label == c).count() >= 2);
-    let keep: Vec<usize> = (0..clips.len())
-        .filter(|&i| classes.binary_search(&clips[i].label).is_ok())
-        .collect();
-    let labels: Vec<u32> = keep
-        .iter()
-        .map(|&i| classes.binary_search(&clips[i].label).unwrap() as u32)
-        .collect();
-    let layout = IntervalLayout::all(N, clips[0].features.dim);
-    let dim = layout.dim();
-    let rows: Vec<Vec<f32>> = keep
-        .iter()
-        .map(|&i| layout.interval_means(&clips[i].features.resample(N)))
-        .collect();
+    let support::ContentRows {
+        classes,
+        labels,
+        rows,
+        dim,
+        ..
+    } = support::content_rows(&dir)?;
     println!(
         "{} clips, {} classes, {} interval means; fold seeds 1..{seeds}\n",
         rows.len(),
@@ -74,10 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     methods.extend(KEPT.iter().map(|k| format!("forest, best {k}")));
     methods.push("diagonal LDA, all".to_string());
     methods.extend(KEPT.iter().map(|k| format!("diagonal LDA, best {k}")));
-    let mut f_sum = vec![0.0f64; methods.len()];
-    let mut f10_sum = vec![0.0f64; methods.len()];
-    println!("| seed | {} |", methods.join(" | "));
-    println!("| --- |{}", " ---: |".repeat(methods.len()));
+    let mut table = support::FTable::new(&methods);
     for seed in 1..=seeds {
         let folds = stratified_folds(&labels, classes.len(), K, seed)?;
         let mut confusion: Vec<ConfusionMatrix> = (0..methods.len())
@@ -111,40 +93,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
-        let f: Vec<f64> = confusion
-            .iter()
-            .map(|m| m.macro_average().f_measure)
-            .collect();
-        for (i, m) in confusion.iter().enumerate() {
-            f_sum[i] += f[i];
-            f10_sum[i] += m.macro_average_over(10).f_measure;
-        }
-        println!(
-            "| {seed} | {} |",
-            f.iter()
-                .map(|v| format!("{v:.3}"))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
+        table.add_seed(seed, &confusion);
     }
-    let row = |sums: &[f64], bold: bool| {
-        sums.iter()
-            .map(|v| {
-                let v = v / seeds as f64;
-                if bold {
-                    format!("**{v:.3}**")
-                } else {
-                    format!("{v:.3}")
-                }
-            })
-            .collect::<Vec<_>>()
-            .join(" | ")
-    };
-    println!(
-        "| mean over the classes with >= 10 clips | {} |",
-        row(&f10_sum, false)
-    );
-    println!("| **mean** | {} |", row(&f_sum, true));
+    table.finish();
     Ok(())
 }
 

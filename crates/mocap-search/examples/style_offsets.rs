@@ -21,51 +21,36 @@ use std::path::PathBuf;
 
 use mocap_search::eval::stratified_folds;
 use mocap_search::forest::argmax;
-use mocap_search::intervals::IntervalLayout;
 use mocap_search::scores::ConfusionMatrix;
-use mocap_search::{load_clips, motion_files, Forest, ForestConfig, LabelRule, NamePattern};
+use mocap_search::{Forest, ForestConfig, LabelRule, NamePattern};
 
-const N: usize = 10;
+mod support;
+
 const K: usize = 5;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let dir = PathBuf::from(args.next().ok_or("usage: style_offsets DIR [SEEDS]")?);
     let seeds: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(5);
-    let files = motion_files(&[dir])?;
-    let content_rule = LabelRule::FromName(NamePattern::parse("bandai-content")?);
+    let support::ContentRows {
+        files,
+        keep,
+        classes,
+        labels,
+        rows,
+        dim,
+    } = support::content_rows(&dir)?;
     let style_rule = LabelRule::FromName(NamePattern::parse("bandai-style")?);
-    let clips = load_clips(&files, &content_rule, false)?;
-    let styles: Vec<String> = files
+    let styles: Vec<String> = keep
         .iter()
-        .map(|p| style_rule.label_of(p).map(|l| l.label))
+        .map(|&i| style_rule.label_of(&files[i]).map(|l| l.label))
         .collect::<Result<_, _>>()?;
-
-    // Classes with at least two clips, as the evaluation keeps them.
-    let mut classes: Vec<String> = clips.iter().map(|c| c.label.clone()).collect();
-    classes.sort();
-    classes.dedup();
-    classes.retain(|c| clips.iter().filter(|k| &k.label == c).count() >= 2);
-    let keep: Vec<usize> = (0..clips.len())
-        .filter(|&i| classes.binary_search(&clips[i].label).is_ok())
-        .collect();
-    let labels: Vec<u32> = keep
-        .iter()
-        .map(|&i| classes.binary_search(&clips[i].label).unwrap() as u32)
-        .collect();
-    let mut style_names: Vec<String> = keep.iter().map(|&i| styles[i].clone()).collect();
+    let mut style_names = styles.clone();
     style_names.sort();
     style_names.dedup();
-    let style_of: Vec<usize> = keep
+    let style_of: Vec<usize> = styles
         .iter()
-        .map(|&i| style_names.binary_search(&styles[i]).unwrap())
-        .collect();
-    let values = clips[0].features.dim;
-    let layout = IntervalLayout::all(N, values);
-    let dim = layout.dim();
-    let rows: Vec<Vec<f32>> = keep
-        .iter()
-        .map(|&i| layout.interval_means(&clips[i].features.resample(N)))
+        .map(|s| style_names.binary_search(s).unwrap())
         .collect();
     println!(
         "{} clips, {} classes, {} styles, {} interval means; fold seeds 1..{seeds}\n",
@@ -84,10 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "offsets: the true style (an oracle)",
         "additive model alone: nearest (content, style) mean",
     ];
-    let mut f_sum = vec![0.0f64; methods.len()];
-    let mut f10_sum = vec![0.0f64; methods.len()];
-    println!("| seed | {} |", methods.join(" | "));
-    println!("| --- |{}", " ---: |".repeat(methods.len()));
+    let mut table = support::FTable::new(&methods);
     for seed in 1..=seeds {
         // The evaluation's own deal of the clips to the folds.
         let folds = stratified_folds(&labels, classes.len(), K, seed)?;
@@ -187,44 +169,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 confusion[6].add(truth, nearest_content);
             }
         }
-        let f: Vec<f64> = confusion
-            .iter()
-            .map(|m| m.macro_average().f_measure)
-            .collect();
-        let f10: Vec<f64> = confusion
-            .iter()
-            .map(|m| m.macro_average_over(10).f_measure)
-            .collect();
-        for (s, v) in f10_sum.iter_mut().zip(&f10) {
-            *s += v;
-        }
-        for (s, v) in f_sum.iter_mut().zip(&f) {
-            *s += v;
-        }
-        println!(
-            "| {seed} | {} |",
-            f.iter()
-                .map(|v| format!("{v:.3}"))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
+        table.add_seed(seed, &confusion);
     }
-    println!(
-        "| mean over the classes with >= 10 clips | {} |",
-        f10_sum
-            .iter()
-            .map(|v| format!("{:.3}", v / seeds as f64))
-            .collect::<Vec<_>>()
-            .join(" | ")
-    );
-    println!(
-        "| **mean** | {} |",
-        f_sum
-            .iter()
-            .map(|v| format!("**{:.3}**", v / seeds as f64))
-            .collect::<Vec<_>>()
-            .join(" | ")
-    );
+    table.finish();
     Ok(())
 }
 

@@ -143,3 +143,26 @@ pub fn test_draws() -> Result<TestDraws, Box<dyn Error>> {
         seeds,
     })
 }
+
+/// Over `takes` takes of `frames` frames in all, the frame-weighted mean of
+/// each of the `columns` errors `row(i)` gives for take `i` (each already
+/// multiplied by the take's frames); the takes run in parallel.
+#[allow(dead_code)] // not every study draws the evaluation's noise
+pub fn mean_over_takes(
+    takes: usize,
+    frames: usize,
+    columns: usize,
+    row: impl Fn(usize) -> Vec<f64> + Sync + Send,
+) -> Vec<f64> {
+    use rayon::prelude::*;
+    let sums = (0..takes).into_par_iter().map(row).reduce(
+        || vec![0.0; columns],
+        |mut a, b| {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += y;
+            }
+            a
+        },
+    );
+    sums.iter().map(|s| s / frames as f64).collect()
+}
