@@ -257,10 +257,11 @@ pub fn pair_boundaries(
             }
         }
     }
+    let subtrees = rotating_subtrees(skeleton);
     let inside_above = |s: &FoundSpike| {
         spikes.iter().any(|a| {
             a.joint != s.joint
-                && skeleton.subtree(a.joint).contains(&s.joint)
+                && subtrees[a.joint].contains(&s.joint)
                 && a.start <= s.start
                 && s.start + s.frames <= a.start + a.frames
         })
