@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! cargo run --profile test -p mocap-search --example unseen_pairs -- \
-//!     ../shared/data/bandai/dataset-2 [SEEDS]
+//!     ../shared/data/bandai/dataset-2 [SEEDS] > bench/search/out/unseen-pairs.md
 //! ```
 //!
 //! Splits (forest as shipped; macro F over the contents, pooled confusion):
@@ -19,11 +19,12 @@
 //!   styles, the style with the other contents: dataset-1's situation with
 //!   14 times its takes);
 //! - **pair left out, one take per other pair**: as above with one random
-//!   take of each other pair (dataset-1's situation, nearly its size);
+//!   take of each other pair (dataset-1's situation at about half its
+//!   training size);
 //! - **style left out**: for every style in turn, the other styles train.
 //!
-//! The random takes are drawn with seeds 1..SEEDS (the splits that draw
-//! none are the same for every seed).
+//! The 5-fold deals and the random takes use seeds 1..SEEDS; the pair and
+//! style left out with all takes draw nothing and run once.
 
 use std::path::PathBuf;
 
