@@ -256,10 +256,9 @@ fn find_by_evidence(
             };
         }
         for j in (0..n).filter(|&j| candidate[j] && score[j] > evidence.threshold) {
-            let beats_below = skeleton
-                .subtree(j)
-                .into_iter()
-                .all(|k| k == j || score[k] <= score[j]);
+            // Joints without rotation channels or candidacy score -inf, so
+            // the rotating subtree is the whole comparison.
+            let beats_below = subtrees[j].iter().all(|&k| k == j || score[k] <= score[j]);
             let mut beats_above = true;
             let mut above = skeleton.joint(j).parent;
             while let Some(a) = above {
@@ -271,5 +270,5 @@ fn find_by_evidence(
             }
         }
     }
-    pair_boundaries(skeleton, &boundaries, max_frames)
+    pair_boundaries(&subtrees, &boundaries, max_frames)
 }

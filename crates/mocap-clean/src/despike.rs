@@ -213,7 +213,7 @@ pub fn find_spikes(motion: &Motion, options: &DespikeOptions) -> Vec<FoundSpike>
             above = skeleton.joint(a).parent;
         }
     }
-    pair_boundaries(skeleton, &boundaries, options.max_frames)
+    pair_boundaries(&subtrees, &boundaries, options.max_frames)
 }
 
 /// Each joint's subtree (itself and every joint below it), keeping only
@@ -234,9 +234,10 @@ pub fn rotating_subtrees(skeleton: &Skeleton) -> Vec<Vec<usize>> {
 /// frames in time order) paired in time order into spikes at most
 /// `max_frames` long, a boundary without a partner left alone, and a spike
 /// inside a spike of a joint above it dropped (it is bridged with that
-/// one). Public for studies that find boundaries another way.
+/// one; `subtrees` from [`rotating_subtrees`], which tells what is above
+/// what). Public for studies that find boundaries another way.
 pub fn pair_boundaries(
-    skeleton: &Skeleton,
+    subtrees: &[Vec<usize>],
     boundaries: &[Vec<usize>],
     max_frames: usize,
 ) -> Vec<FoundSpike> {
@@ -257,7 +258,6 @@ pub fn pair_boundaries(
             }
         }
     }
-    let subtrees = rotating_subtrees(skeleton);
     let inside_above = |s: &FoundSpike| {
         spikes.iter().any(|a| {
             a.joint != s.joint
