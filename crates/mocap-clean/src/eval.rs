@@ -474,6 +474,23 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             Some(p) => ModelFile::load(p, options.device)?,
             None => ModelFile::Network(Box::new(CleanModel::load_default(options.device)?)),
         };
+        // Said before any work, naming the take: a model of another rig
+        // would otherwise fail on that take after minutes of tuning.
+        for take in &takes {
+            model.check_rig(&take.motion).map_err(|e| {
+                CleanError::Invalid(format!(
+                    "{}: the model \"{}\" cannot clean this take: {e}. To evaluate the filters \
+                     on takes of other rigs, {}",
+                    take.path.display(),
+                    m.label,
+                    if m.path.is_none() {
+                        "leave the shipped model out with --no-default-model"
+                    } else {
+                        "leave this --model out"
+                    }
+                ))
+            })?;
+        }
         models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
     }
     let detector = match &options.spike_detector {
@@ -519,6 +536,22 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             tune_takes.len()
         ));
     }
+    let short: Vec<_> = takes
+        .iter()
+        .filter(|t| t.motion.frame_count() < 3)
+        .collect();
+    if !short.is_empty() {
+        notes.push(format!(
+            "{} take(s) of under 3 frames ({}) are left out of the acceleration errors, which \
+             need three",
+            short.len(),
+            short
+                .iter()
+                .map(|t| t.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
     if takes.len() < 2 {
         notes.push(
             "one take: a spike pastes another take's motion, so the spike conditions have no \
@@ -549,8 +582,11 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         let owned = cleaners_for(filters, &models, detector.as_ref());
         let cleaners: Vec<_> = owned.iter().collect();
         let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
+        // Frame-weighted sums of the three metrics and the frames each was
+        // defined on: a take too short for one (an acceleration needs three
+        // frames) is left out of that metric's mean, not made NaN of it.
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
-        let mut frames_total = 0usize;
+        let mut weights = vec![[0.0f64; 3]; methods.len() + 1];
         let bar = mocap_nn::train::work_bar(
             takes.len() as u64,
             &format!("takes cleaned ({} noise)", CONDITIONS[condition]),
@@ -559,13 +595,15 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             let clean = &takes[i].motion;
             let noisy = make_noisy(&takes, i, condition, options)?;
             let w = clean.frame_count() as f64;
-            frames_total += clean.frame_count();
             let mut add = |slot: usize, m: &Motion| {
                 let r = rotation_error_deg(clean, m);
                 let (p, a) = position_errors(clean, m);
-                sums[slot][0] += r * w;
-                sums[slot][1] += p * w;
-                sums[slot][2] += a * w;
+                for (metric, value) in [r, p, a].into_iter().enumerate() {
+                    if value.is_finite() {
+                        sums[slot][metric] += value * w;
+                        weights[slot][metric] += w;
+                    }
+                }
             };
             add(0, &noisy);
             run_methods(&cleaners, &methods, &noisy, |k, m| add(k + 1, m))?;
@@ -573,14 +611,21 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         }
         bar.finish_and_clear();
         let names = std::iter::once("noisy input").chain(methods.iter().map(|m| m.label.as_str()));
-        for (name, s) in names.zip(&sums) {
-            let n = frames_total.max(1) as f64;
+        for ((name, s), w) in names.zip(&sums).zip(&weights) {
+            // NaN (JSON null) only when no take defines the metric.
+            let mean = |metric: usize| {
+                if w[metric] > 0.0 {
+                    s[metric] / w[metric]
+                } else {
+                    f64::NAN
+                }
+            };
             entries.push(MethodMetrics {
                 method: name.to_string(),
                 condition: CONDITIONS[condition].into(),
-                rotation_error_deg: s[0] / n,
-                position_error: s[1] / n,
-                acceleration_error: s[2] / n,
+                rotation_error_deg: mean(0),
+                position_error: mean(1),
+                acceleration_error: mean(2),
             });
         }
     }

@@ -478,6 +478,15 @@ impl ModelFile {
         }
     }
 
+    /// `Ok` when this model can clean `motion` (it was trained or fitted on
+    /// `motion`'s rig), else the error [`ModelFile::clean`] would give.
+    pub fn check_rig(&self, motion: &Motion) -> Result<()> {
+        match self {
+            ModelFile::Network(model) => model.layout_for(motion).map(|_| ()),
+            ModelFile::Wiener(filter) => filter.layout_for(motion).map(|_| ()),
+        }
+    }
+
     /// Cleans `motion` (`hop`: see [`CleanModel::clean`]); also says what
     /// ran, e.g. `Wiener filter (sigma 4.2 deg)`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<(Motion, String)> {

@@ -876,7 +876,7 @@ impl WienerFilter {
     }
 
     /// The features of `motion`'s rig, or an error naming both rigs.
-    fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
+    pub(crate) fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
         let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
         let names = layout.joint_names(motion.skeleton());
         if names != self.description.joints {

@@ -899,6 +899,57 @@ fn clean_eval_says_what_its_figures_leave_out() {
 }
 
 #[test]
+fn clean_eval_names_a_take_the_model_cannot_clean_and_skips_short_takes_in_accelerations() {
+    let dir = tempfile::tempdir().unwrap();
+    let walk = dir.path().join("walk.bvh");
+    std::fs::copy(mocap_testdata::sample_walk(), &walk).unwrap();
+    // A take of 2 frames: it has rotation and position errors but no
+    // acceleration, which must not turn the whole column into null.
+    let short = dir.path().join("short.bvh");
+    let out = mocap(&["convert", path(&walk), path(&short), "--frames", "0..2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = mocap(&[
+        "clean",
+        "eval",
+        path(dir.path()),
+        "--all-takes",
+        "--no-default-model",
+        "--spike-lengths",
+        "none",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let entries = report["entries"].as_array().unwrap();
+    assert!(!entries.is_empty());
+    for e in entries {
+        let a = e["acceleration_error"].as_f64();
+        assert!(a.is_some_and(|a| a.is_finite() && a >= 0.0), "{e}");
+    }
+    let notes = report["notes"].to_string();
+    assert!(notes.contains("under 3 frames (short)"), "{notes}");
+
+    // A take of another rig, with the shipped model asked for: refused
+    // before any work, naming the take and the way out.
+    std::fs::remove_file(&short).unwrap();
+    let other = dir.path().join("other-rig.bvh");
+    std::fs::write(
+        &other,
+        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition \
+         Zrotation Xrotation Yrotation\n  JOINT Knee\n  {\n    OFFSET 0 -40 0\n    CHANNELS 3 \
+         Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -40 0\n    }\n  }\n}\n\
+         MOTION\nFrames: 3\nFrame Time: 0.0333333\n0 90 0 0 0 0 10 0 0\n0 90 0 0 0 0 12 0 0\n\
+         0 90 0 0 0 0 14 0 0\n",
+    )
+    .unwrap();
+    let out = mocap(&["clean", "eval", path(dir.path()), "--all-takes"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("other-rig.bvh"), "{err}");
+    assert!(err.contains("--no-default-model"), "{err}");
+}
+
+#[test]
 fn style_apply_says_when_the_source_is_unlike_the_walks_the_model_knows() {
     let dir = tempfile::tempdir().unwrap();
     let out_path = dir.path().join("out.bvh");
