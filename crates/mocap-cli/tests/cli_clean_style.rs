@@ -848,6 +848,23 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
     );
 }
 
+/// `mocap clean eval DIR --no-default-model --spike-lengths none` then
+/// `extra`: the filters alone, quick on the bundled takes; must succeed.
+fn clean_eval_filters(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "clean",
+        "eval",
+        path(dir),
+        "--no-default-model",
+        "--spike-lengths",
+        "none",
+    ];
+    args.extend_from_slice(extra);
+    let out = mocap(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    out
+}
+
 #[test]
 fn clean_eval_says_what_its_figures_leave_out() {
     // One take: no validation takes to tune the filters on, and no other
@@ -855,16 +872,7 @@ fn clean_eval_says_what_its_figures_leave_out() {
     // showing fewer rows and spike-free spike conditions.
     let dir = tempfile::tempdir().unwrap();
     std::fs::copy(mocap_testdata::sample_walk(), dir.path().join("walk.bvh")).unwrap();
-    let out = mocap(&[
-        "clean",
-        "eval",
-        path(dir.path()),
-        "--no-default-model",
-        "--spike-lengths",
-        "none",
-        "--json",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = clean_eval_filters(dir.path(), &["--json"]);
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let notes: Vec<&str> = report["notes"]
         .as_array()
@@ -881,16 +889,7 @@ fn clean_eval_says_what_its_figures_leave_out() {
         dir.path().join("proud.bvh"),
     )
     .unwrap();
-    let out = mocap(&[
-        "clean",
-        "eval",
-        path(dir.path()),
-        "--all-takes",
-        "--no-default-model",
-        "--spike-lengths",
-        "none",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = clean_eval_filters(dir.path(), &["--all-takes"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("tuned on the first 2 of the evaluated takes themselves"),
@@ -908,17 +907,7 @@ fn clean_eval_names_a_take_the_model_cannot_clean_and_skips_short_takes_in_accel
     let short = dir.path().join("short.bvh");
     let out = mocap(&["convert", path(&walk), path(&short), "--frames", "0..2"]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let out = mocap(&[
-        "clean",
-        "eval",
-        path(dir.path()),
-        "--all-takes",
-        "--no-default-model",
-        "--spike-lengths",
-        "none",
-        "--json",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = clean_eval_filters(dir.path(), &["--all-takes", "--json"]);
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let entries = report["entries"].as_array().unwrap();
     assert!(!entries.is_empty());
