@@ -61,6 +61,11 @@ pub fn position_errors(a: &Motion, b: &Motion) -> (f64, f64) {
     (position, acceleration)
 }
 
+/// Whether `motion` is long enough for an acceleration error.
+fn has_acceleration(motion: &Motion) -> bool {
+    motion.frame_count() >= metrics::ACCELERATION_MIN_FRAMES
+}
+
 /// The metrics of one method under one noise condition.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MethodMetrics {
@@ -448,6 +453,28 @@ fn methods(
     Ok(out)
 }
 
+/// An error naming the first of `takes` that `model` (`entry`) cannot
+/// clean, said before any work: it would otherwise fail on that take,
+/// unnamed, after minutes of tuning.
+fn refuse_other_rigs(model: &ModelFile, entry: &ModelEntry, takes: &[Take]) -> Result<()> {
+    for take in takes {
+        model.check_rig(&take.motion).map_err(|e| {
+            CleanError::Invalid(format!(
+                "{}: the model \"{}\" cannot clean this take: {e}. To evaluate the filters on \
+                 takes of other rigs, {}",
+                take.path.display(),
+                entry.label,
+                if entry.path.is_none() {
+                    "leave the shipped model out with --no-default-model"
+                } else {
+                    "leave this --model out"
+                }
+            ))
+        })?;
+    }
+    Ok(())
+}
+
 /// Runs the evaluation.
 pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     let paths = list_bvh(&options.inputs)?;
@@ -474,23 +501,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             Some(p) => ModelFile::load(p, options.device)?,
             None => ModelFile::Network(Box::new(CleanModel::load_default(options.device)?)),
         };
-        // Said before any work, naming the take: a model of another rig
-        // would otherwise fail on that take after minutes of tuning.
-        for take in &takes {
-            model.check_rig(&take.motion).map_err(|e| {
-                CleanError::Invalid(format!(
-                    "{}: the model \"{}\" cannot clean this take: {e}. To evaluate the filters \
-                     on takes of other rigs, {}",
-                    take.path.display(),
-                    m.label,
-                    if m.path.is_none() {
-                        "leave the shipped model out with --no-default-model"
-                    } else {
-                        "leave this --model out"
-                    }
-                ))
-            })?;
-        }
+        refuse_other_rigs(&model, m, &takes)?;
         models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
     }
     let detector = match &options.spike_detector {
@@ -514,6 +525,14 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     } else {
         Vec::new()
     };
+    if options.despike {
+        // Spike finding is tuned per model on these takes too.
+        for (m, (_, cleaner)) in options.models.iter().zip(&models) {
+            if let Cleaner::Model(model) = cleaner {
+                refuse_other_rigs(model, m, &tune_takes)?;
+            }
+        }
+    }
     let mut notes = Vec::new();
     if options.filters && tune_takes.len() < 2 {
         notes.push(format!(
@@ -538,18 +557,19 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     }
     let short: Vec<_> = takes
         .iter()
-        .filter(|t| t.motion.frame_count() < 3)
+        .filter(|t| !has_acceleration(&t.motion))
         .collect();
     if !short.is_empty() {
         notes.push(format!(
-            "{} take(s) of under 3 frames ({}) are left out of the acceleration errors, which \
-             need three",
+            "{} take(s) of under {min} frames ({}) are left out of the acceleration errors, \
+             which need {min}",
             short.len(),
             short
                 .iter()
                 .map(|t| t.name.as_str())
                 .collect::<Vec<_>>()
-                .join(", ")
+                .join(", "),
+            min = metrics::ACCELERATION_MIN_FRAMES,
         ));
     }
     if takes.len() < 2 {
@@ -583,8 +603,9 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         let cleaners: Vec<_> = owned.iter().collect();
         let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
         // Frame-weighted sums of the three metrics and the frames each was
-        // defined on: a take too short for one (an acceleration needs three
-        // frames) is left out of that metric's mean, not made NaN of it.
+        // defined on: a take too short for the acceleration is left out of
+        // its mean, not made NaN of it. Only for that reason: a method that
+        // outputs NaN on some take still shows as NaN (null in JSON).
         let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
         let mut weights = vec![[0.0f64; 3]; methods.len() + 1];
         let bar = mocap_nn::train::work_bar(
@@ -595,11 +616,13 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             let clean = &takes[i].motion;
             let noisy = make_noisy(&takes, i, condition, options)?;
             let w = clean.frame_count() as f64;
+            let any = clean.frame_count() > 0;
+            let defined = [any, any, has_acceleration(clean)];
             let mut add = |slot: usize, m: &Motion| {
                 let r = rotation_error_deg(clean, m);
                 let (p, a) = position_errors(clean, m);
                 for (metric, value) in [r, p, a].into_iter().enumerate() {
-                    if value.is_finite() {
+                    if defined[metric] {
                         sums[slot][metric] += value * w;
                         weights[slot][metric] += w;
                     }

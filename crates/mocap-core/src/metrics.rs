@@ -99,12 +99,16 @@ fn rotates(a: &Motion, b: &Motion, joint: usize) -> bool {
         || b.skeleton().joint(joint).has_rotation_channels()
 }
 
+/// The fewest frames [`acceleration_error`] is defined on: a second
+/// difference needs a frame on each side.
+pub const ACCELERATION_MIN_FRAMES: usize = 3;
+
 /// Acceleration error: the mean over frames `1..n-1` and over `joints` of
 /// `|(a[t+1] - 2 a[t] + a[t-1]) - (b[t+1] - 2 b[t] + b[t-1])|`, the norm of
 /// the difference of the second finite differences of the positions, in
 /// units per frame² (as in the human-motion literature, e.g. Kanazawa et
 /// al., "Learning 3D Human Dynamics from Video", CVPR 2019). Needs at least
-/// three frames.
+/// [`ACCELERATION_MIN_FRAMES`] frames.
 pub fn acceleration_error(
     a: &GlobalPoses,
     b: &GlobalPoses,
@@ -112,7 +116,7 @@ pub fn acceleration_error(
 ) -> Result<f32> {
     same_shape(a, b)?;
     let joints = joint_selection(joints, a.joint_count)?;
-    nonempty(a.frame_count, 3, "an acceleration")?;
+    nonempty(a.frame_count, ACCELERATION_MIN_FRAMES, "an acceleration")?;
     let accel = |p: &GlobalPoses, f: usize, j: usize| {
         p.position(f + 1, j) - 2.0 * p.position(f, j) + p.position(f - 1, j)
     };
