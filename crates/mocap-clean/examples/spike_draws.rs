@@ -19,7 +19,7 @@
 mod support;
 
 use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions, FoundSpike};
-use mocap_clean::eval::{noisy_take, rotation_error_deg, EvalOptions};
+use mocap_clean::eval::{noisy_take, rotation_error_deg};
 use mocap_clean::filters::{filter_motion, Filter};
 use mocap_clean::infer::CleanModel;
 
@@ -31,11 +31,8 @@ use mocap_clean::infer::CleanModel;
 const COLUMNS: usize = 10;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let support::TestDraws {
-        takes,
-        frames,
-        seeds,
-    } = support::test_draws()?;
+    let draws = support::test_draws()?;
+    let (takes, frames) = (&draws.takes, draws.frames);
     let model = CleanModel::load_default(Default::default())?;
     let finders = [
         DespikeOptions::default(),
@@ -59,13 +56,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "| ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
     );
-    let mut pooled = [0.0f64; COLUMNS];
-    for &seed in &seeds {
-        let options = EvalOptions {
-            seed,
-            ..EvalOptions::default()
-        };
-        let mean = support::mean_over_takes(takes.len(), frames, COLUMNS, |i| {
+    support::over_draws(
+        &draws,
+        COLUMNS,
+        |options, i| {
             let clean = &takes[i].motion;
             let weight = clean.frame_count() as f64;
             let error = |m: &mocap_core::Motion| rotation_error_deg(clean, m) * weight;
@@ -75,7 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 (error(&bridged), error(&cleaned))
             };
             let mut row = [0.0f64; COLUMNS];
-            let (spiked, spikes) = noisy_take(&takes, i, 1, &options).expect("noise");
+            let (spiked, spikes) = noisy_take(takes, i, 1, options).expect("noise");
             row[0] = found_then_model(&spiked, &finders[0]).1;
             row[1] = found_then_model(&spiked, &finders[1]).1;
             let filtered = |f: Filter| error(&filter_motion(&spiked, &f).expect("filter"));
@@ -90,18 +84,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .clean(&bridge_spikes(&spiked, &truth), None)
                     .expect("clean"),
             );
-            let alone = noisy_take(&takes, i, 2, &options).expect("noise").0;
+            let alone = noisy_take(takes, i, 2, options).expect("noise").0;
             row[9] = error(&filter_motion(&alone, &Filter::Median { window: 3 }).expect("filter"));
             (row[4], row[6]) = found_then_model(&alone, &finders[0]);
             (row[5], row[7]) = found_then_model(&alone, &finders[1]);
             row.to_vec()
-        });
-        for (p, m) in pooled.iter_mut().zip(&mean) {
-            *p += m / seeds.len() as f64;
-        }
-        print_row(&seed.to_string(), &mean);
-    }
-    print_row("mean", &pooled);
+        },
+        print_row,
+        "mean",
+    );
     Ok(())
 }
 

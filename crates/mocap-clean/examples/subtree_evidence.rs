@@ -123,11 +123,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// validation grid, on the test takes over several draws of the
 /// evaluation's noise.
 fn test_draws() -> Result<(), Box<dyn std::error::Error>> {
-    let support::TestDraws {
-        takes,
-        frames,
-        seeds,
-    } = support::test_draws()?;
+    let draws = support::test_draws()?;
+    let (takes, frames) = (&draws.takes, draws.frames);
     let model = CleanModel::load_default(Default::default())?;
     let settings = [(1.5f32, 8.0f32, 2.0f32), (1.5, 8.0, 3.0), (1.5, 8.0, 4.5)].map(
         |(offset, cap, threshold)| Evidence {
@@ -164,20 +161,17 @@ fn test_draws() -> Result<(), Box<dyn std::error::Error>> {
     header.push("cross-validated Butterworth, spikes on random".into());
     println!("| {} |", header.join(" | "));
     println!("| ---: |{}", " ---: |".repeat(columns));
-    let mut pooled = vec![0.0f64; columns];
-    for &seed in &seeds {
-        let options = mocap_clean::eval::EvalOptions {
-            seed,
-            ..Default::default()
-        };
-        let mean = support::mean_over_takes(takes.len(), frames, columns, |i| {
+    support::over_draws(
+        &draws,
+        columns,
+        |options, i| {
             let clean = &takes[i].motion;
             let weight = clean.frame_count() as f64;
             let error = |m: &Motion| rotation_error_deg(clean, m) * weight;
             let mut row = vec![0.0f64; columns];
             for kind in 0..3 {
                 let (noisy, _) =
-                    mocap_clean::eval::noisy_take(&takes, i, kind, &options).expect("noise");
+                    mocap_clean::eval::noisy_take(takes, i, kind, options).expect("noise");
                 let jumps = normalised_jumps(&noisy, 1, true);
                 let mut found = vec![find_spikes(&noisy, &DespikeOptions::default())];
                 found.extend(
@@ -203,13 +197,10 @@ fn test_draws() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             row
-        });
-        for (p, m) in pooled.iter_mut().zip(&mean) {
-            *p += m / seeds.len() as f64;
-        }
-        print_draw(&seed.to_string(), &mean);
-    }
-    print_draw("**mean**", &pooled);
+        },
+        print_draw,
+        "**mean**",
+    );
     Ok(())
 }
 

@@ -23,10 +23,8 @@
 
 use std::path::PathBuf;
 
-use mocap_search::eval::stratified_folds;
 use mocap_search::forest::{argmax, Samples};
-use mocap_search::scores::ConfusionMatrix;
-use mocap_search::{Forest, ForestConfig};
+use mocap_search::Forest;
 
 mod support;
 
@@ -60,16 +58,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     methods.push("diagonal LDA, all".to_string());
     methods.extend(KEPT.iter().map(|k| format!("diagonal LDA, best {k}")));
     let mut table = support::FTable::new(&methods);
-    for seed in 1..=seeds {
-        let folds = stratified_folds(&labels, classes.len(), K, seed)?;
-        let mut confusion: Vec<ConfusionMatrix> = (0..methods.len())
-            .map(|_| ConfusionMatrix::new(classes.len()))
-            .collect();
-        for (f, fold) in folds.iter().enumerate() {
-            let config = ForestConfig {
-                seed: seed * 1000 + f as u64,
-                ..ForestConfig::default()
-            };
+    table.cross_validate(
+        &labels,
+        classes.len(),
+        seeds,
+        K,
+        |fold, config, confusion| {
             let stats = ContentStatistics::fit(&fold.train, &rows, &labels, classes.len());
             let mut order: Vec<usize> = (0..dim).collect();
             order.sort_by(|&a, &b| stats.fisher[b].total_cmp(&stats.fisher[a]));
@@ -83,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let train_rows: Vec<f32> = fold.train.iter().flat_map(|&i| pick(i)).collect();
                 let samples =
                     Samples::new(&train_rows, columns.len(), &train_labels, classes.len())?;
-                let forest = Forest::train(&samples, &config, &|| {});
+                let forest = Forest::train(&samples, config, &|| {});
                 let lda = column_sets.len() + m;
                 for &i in &fold.test {
                     let row: Vec<f32> = pick(i).collect();
@@ -92,9 +86,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     confusion[lda].add(truth, stats.nearest_content(&rows[i], columns));
                 }
             }
-        }
-        table.add_seed(seed, &confusion);
-    }
+            Ok(())
+        },
+    )?;
     table.finish();
     Ok(())
 }

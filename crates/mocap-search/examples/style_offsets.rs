@@ -19,9 +19,7 @@
 
 use std::path::PathBuf;
 
-use mocap_search::eval::stratified_folds;
 use mocap_search::forest::argmax;
-use mocap_search::scores::ConfusionMatrix;
 use mocap_search::{Forest, ForestConfig, LabelRule, NamePattern};
 
 mod support;
@@ -70,26 +68,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "additive model alone: nearest (content, style) mean",
     ];
     let mut table = support::FTable::new(&methods);
-    for seed in 1..=seeds {
-        // The evaluation's own deal of the clips to the folds.
-        let folds = stratified_folds(&labels, classes.len(), K, seed)?;
-        let mut confusion: Vec<ConfusionMatrix> = (0..methods.len())
-            .map(|_| ConfusionMatrix::new(classes.len()))
-            .collect();
-        for (f, fold) in folds.iter().enumerate() {
+    table.cross_validate(
+        &labels,
+        classes.len(),
+        seeds,
+        K,
+        |fold, config, confusion| {
             let (train, test) = (&fold.train, &fold.test);
-            let config = ForestConfig {
-                seed: seed * 1000 + f as u64,
-                ..ForestConfig::default()
-            };
             let train_labels: Vec<u32> = train.iter().map(|&i| labels[i]).collect();
             // The forest as shipped.
             let plain_rows: Vec<f32> = train.iter().flat_map(|&i| rows[i].clone()).collect();
-            let plain = train_forest(&plain_rows, dim, &train_labels, classes.len(), &config);
+            let plain = train_forest(&plain_rows, dim, &train_labels, classes.len(), config);
             // The style forest (for the weighted combination).
             let train_styles: Vec<u32> = train.iter().map(|&i| style_of[i] as u32).collect();
             let style_forest =
-                train_forest(&plain_rows, dim, &train_styles, style_names.len(), &config);
+                train_forest(&plain_rows, dim, &train_styles, style_names.len(), config);
             // The additive model on the training clips.
             let (mu, offsets) = additive_model(
                 train,
@@ -103,7 +96,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .flat_map(|&i| subtract(&rows[i], &offsets[style_of[i]]))
                 .collect();
-            let forest = train_forest(&corrected, dim, &train_labels, classes.len(), &config);
+            let forest = train_forest(&corrected, dim, &train_labels, classes.len(), config);
             let scale = feature_scale(train, &rows);
             for &i in test {
                 let truth = labels[i] as usize;
@@ -168,9 +161,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .unwrap();
                 confusion[6].add(truth, nearest_content);
             }
-        }
-        table.add_seed(seed, &confusion);
-    }
+            Ok(())
+        },
+    )?;
     table.finish();
     Ok(())
 }

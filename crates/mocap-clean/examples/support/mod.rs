@@ -166,3 +166,34 @@ pub fn mean_over_takes(
     );
     sums.iter().map(|s| s / frames as f64).collect()
 }
+
+/// The loop of the studies that draw the evaluation's noise again: for
+/// each seed of `draws`, the frame-weighted mean over its takes of the
+/// `columns` errors `row(options, i)` gives for take `i` (each multiplied
+/// by the take's frames; `options` the evaluation's, with that seed),
+/// printed by `print` under the seed; then the mean over the seeds, under
+/// `mean_label`.
+#[allow(dead_code)] // not every study draws the evaluation's noise
+pub fn over_draws(
+    draws: &TestDraws,
+    columns: usize,
+    row: impl Fn(&mocap_clean::eval::EvalOptions, usize) -> Vec<f64> + Sync + Send,
+    print: impl Fn(&str, &[f64]),
+    mean_label: &str,
+) {
+    let mut pooled = vec![0.0f64; columns];
+    for &seed in &draws.seeds {
+        let options = mocap_clean::eval::EvalOptions {
+            seed,
+            ..Default::default()
+        };
+        let mean = mean_over_takes(draws.takes.len(), draws.frames, columns, |i| {
+            row(&options, i)
+        });
+        for (p, m) in pooled.iter_mut().zip(&mean) {
+            *p += m / draws.seeds.len() as f64;
+        }
+        print(&seed.to_string(), &mean);
+    }
+    print(mean_label, &pooled);
+}

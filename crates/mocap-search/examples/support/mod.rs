@@ -97,6 +97,40 @@ impl FTable {
         println!("| {seed} | {} |", cells(&f, 1.0, false));
     }
 
+    /// The studies' cross-validation, a row per fold seed `1..=seeds`: the
+    /// evaluation's deal of the clips to `k` folds
+    /// ([`mocap_search::eval::stratified_folds`]), and for each fold the
+    /// forest settings with the fold's own seed; `fold(fold, config,
+    /// confusion)` adds the fold's test clips to one confusion per method.
+    pub fn cross_validate(
+        &mut self,
+        labels: &[u32],
+        classes: usize,
+        seeds: u64,
+        k: usize,
+        mut fold: impl FnMut(
+            &mocap_search::eval::Fold,
+            &mocap_search::forest::ForestConfig,
+            &mut [mocap_search::scores::ConfusionMatrix],
+        ) -> Result<(), Box<dyn Error>>,
+    ) -> Result<(), Box<dyn Error>> {
+        for seed in 1..=seeds {
+            let folds = mocap_search::eval::stratified_folds(labels, classes, k, seed)?;
+            let mut confusion: Vec<_> = (0..self.methods)
+                .map(|_| mocap_search::scores::ConfusionMatrix::new(classes))
+                .collect();
+            for (f, one) in folds.iter().enumerate() {
+                let config = mocap_search::forest::ForestConfig {
+                    seed: seed * 1000 + f as u64,
+                    ..Default::default()
+                };
+                fold(one, &config, &mut confusion)?;
+            }
+            self.add_seed(seed, &confusion);
+        }
+        Ok(())
+    }
+
     /// Prints the two rows of means.
     pub fn finish(self) {
         let n = self.seeds.max(1) as f64;
