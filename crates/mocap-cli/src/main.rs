@@ -97,3 +97,66 @@ fn main() -> ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Groups shared by several subcommands (`commands::args`); their options
+    /// are not a subcommand's own.
+    const SHARED_GROUPS: [&str; 3] = ["DeviceArgs", "ReportArgs", "TrainLoopArgs"];
+    const MAX_OWN_OPTIONS: usize = 15;
+
+    /// Every rule of `commands::args`, on every subcommand; the failure lists
+    /// each breach with the command that breaks it.
+    #[test]
+    fn cli_language() {
+        let mut breaches = Vec::new();
+        check(&super::Cli::command(), "mocap", &mut breaches);
+        assert!(breaches.is_empty(), "{}", breaches.join("\n"));
+    }
+
+    fn check(command: &clap::Command, path: &str, breaches: &mut Vec<String>) {
+        for sub in command.get_subcommands() {
+            check(sub, &format!("{path} {}", sub.get_name()), breaches);
+        }
+        let shared: Vec<&str> = command
+            .get_groups()
+            .filter(|g| SHARED_GROUPS.contains(&g.get_id().as_str()))
+            .flat_map(|g| g.get_args())
+            .map(|id| id.as_str())
+            .collect();
+        let mut own = 0;
+        for arg in command.get_arguments() {
+            let id = arg.get_id().as_str();
+            if arg.is_global_set() || arg.is_positional() || ["help", "version"].contains(&id) {
+                continue;
+            }
+            let long = arg.get_long().unwrap_or("");
+            let takes_value = arg.get_num_args().is_some_and(|n| n.takes_values());
+            if !shared.contains(&id) {
+                own += 1;
+            }
+            if arg.get_short() == Some('o') && long != "output" {
+                breaches.push(format!("{path}: -o is --{long}, not --output"));
+            }
+            if ["out", "md", "output-dir", "out-dir"].contains(&long) {
+                breaches.push(format!("{path}: --{long} (say --output or --markdown)"));
+            }
+            if long == "json" && takes_value {
+                breaches.push(format!("{path}: --json takes a value (it is a switch)"));
+            }
+            if long == "markdown" && !takes_value {
+                breaches.push(format!("{path}: --markdown takes no FILE"));
+            }
+            if long == "device" && !shared.contains(&id) {
+                breaches.push(format!("{path}: --device outside commands::args::DeviceArgs"));
+            }
+        }
+        if command.get_subcommands().next().is_none() && own > MAX_OWN_OPTIONS {
+            breaches.push(format!(
+                "{path}: {own} options of its own (at most {MAX_OWN_OPTIONS})"
+            ));
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! One module per subcommand: its arguments and a `run` that calls the
 //! libraries.
 
+pub mod args;
 pub mod clean;
 pub mod convert;
 pub mod demo;

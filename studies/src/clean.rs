@@ -1,0 +1,1 @@
+//! Setup shared by the clean studies (`studies/examples/clean_*.rs`).

@@ -1,0 +1,1 @@
+//! Setup shared by the fuse studies (`studies/examples/fuse_*.rs`).

@@ -1,0 +1,1 @@
+//! Setup shared by the search studies (`studies/examples/search_*.rs`).

@@ -1,0 +1,1 @@
+//! Setup shared by the style studies (`studies/examples/style_*.rs`).
