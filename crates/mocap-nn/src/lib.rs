@@ -53,3 +53,24 @@ pub enum NnError {
 }
 
 pub type Result<T, E = NnError> = std::result::Result<T, E>;
+
+/// Errors of a learned capability (`mocap-clean`, `mocap-style`): reading
+/// the data, the networks, or a request that does not fit the data or the
+/// model. Each capability names it as its own (`CleanError`, `StyleError`).
+#[derive(Debug, thiserror::Error)]
+pub enum CapabilityError {
+    #[error(transparent)]
+    Core(#[from] mocap_core::Error),
+    #[error(transparent)]
+    Nn(#[from] NnError),
+    /// A request that does not fit the data or the model.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl CapabilityError {
+    /// A request that does not fit the data or the model.
+    pub fn invalid(message: impl Into<String>) -> Self {
+        Self::Invalid(message.into())
+    }
+}

@@ -69,6 +69,13 @@ impl History {
 /// Set by a front end's `--quiet`: no training progress bars at all.
 static PROGRESS_HIDDEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
+/// The seed of one epoch's random draws (windows, noise) from a run's seed:
+/// each epoch draws anew, and the same run seed repeats the whole run, also
+/// when it is resumed at an epoch.
+pub fn epoch_seed(seed: u64, epoch: usize) -> u64 {
+    seed ^ (epoch as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+}
+
 /// Hides (or shows again) every training progress bar of this process; the
 /// CLI calls it for `--quiet`.
 pub fn hide_progress(hidden: bool) {
