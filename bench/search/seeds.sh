@@ -1,26 +1,21 @@
 #!/usr/bin/env bash
-# The forest's F-measure over several fold assignments: 5-fold
-# cross-validation by take with fold seeds 1..S (the forest seeds follow the
-# fold number), forest only. One seed's F on a small data set moves by a
-# clip or two; the mean over seeds is what a feature or parameter change is
-# judged by.
+# Reproduces the fold-seed table of bench/results/search.md (bench/search/out/seeds.md), one row per call: the
+# forest's mean accuracy and macro F over 5-fold cross-validations by take with fold seeds 1..S.
 #
-#   bash bench/search/seeds.sh PATTERN FOLDER [SEEDS] [-- extra eval options]
+#   bash bench/search/seeds.sh PATTERN FOLDER [SEEDS] [-- extra `mocap search eval` options]
 #
-# Prints one Markdown table row: seeds, mean accuracy, mean macro F over all
-# classes, mean macro F over classes with >= 10 clips, and the lowest and
-# highest F over all classes. EVAL=path runs another build of the eval
-# example (e.g. one built from an older commit, to compare).
+# Prints one Markdown table row: seeds, mean accuracy, mean macro F over all classes, mean macro F over classes
+# with >= 10 clips, and the lowest and highest F over all classes. MOCAP=path/to/mocap runs a built binary.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 pattern=$1 folder=$2 seeds=${3:-20}
 shift $(($# >= 3 ? 3 : 2))
 [ "${1:-}" = "--" ] && shift
-EVAL=${EVAL:-${CARGO_TARGET_DIR:-target}/release/examples/search_eval}
+MOCAP=${MOCAP:-cargo run --release -q -p mocap-cli --}
 TMP="$(mktemp -d)"
 trap 'rm -rf "$TMP"' EXIT
 for s in $(seq 1 "$seeds"); do
-    "$EVAL" --labels-from-name "$pattern" --folds 5 --seed "$s" --no-baselines \
+    $MOCAP -q search eval --labels-from-name "$pattern" --folds 5 --seed "$s" --no-baselines \
         --no-unseen --no-takes --json "$@" "$folder" >"$TMP/$s.json"
 done
 python3 - "$TMP" "$seeds" <<'PY'
