@@ -55,10 +55,10 @@ done
     echo "| --- | --- | ---: | ---: | ---: | ---: | ---: |"
     cat "$rows"/*.md
     echo
-    echo "Crashes found and fixed (each kept as a regression test in crates/mocap-core/tests/fuzz_regressions.rs):"
+    echo "Crashes these targets found, each kept as a regression test in crates/mocap-core/tests/fuzz_regressions.rs:"
     echo
-    echo "- bvh, first run (146,038 executions): a JOINT name holding NUL and CR bytes was read but could not be"
-    echo "  written back. The reader now refuses control characters in joint names with a located error."
+    echo "- bvh (after 146,038 executions): a JOINT name holding NUL and CR bytes could be read but not written"
+    echo "  back. The reader refuses control characters in joint names with a located error."
 } > "$report.tmp"
 mv "$report.tmp" "$report"
 cat "$report"

@@ -1,28 +1,22 @@
 #!/usr/bin/env bash
-# The source's left-right asymmetry: kept along the take (averaged over two
-# strides around each frame; the default since session 17), kept as one offset
-# per clip (`--asymmetry source-clip`, the default of session 16) and not kept
-# (`--asymmetry style`, the report's method). First the same evaluation as
-# run.sh and run.sh --other-fold with the two other settings, then takes that
-# walk straight and then turn (or turn, then walk), joined from held-out
-# dataset-2 clips and restyled with each setting (example asymmetry_along),
-# then the tables (bench/results/style.md, "Turns kept"). About 7 minutes; run
-# after run.sh and run.sh --other-fold, whose eval.json files are the
-# default's side. The other settings' reports (about 1 MB each) stay in
-# ${RUNS_DIR:-/tmp/style-asymmetry}.
-#
-#   bash bench/style/asymmetry.sh      # writes bench/style/out/asymmetry.md
+# Reproduces bench/style/out/asymmetry.md (bench/results/style.md, "Turns kept
+# along the take"): the evaluation of run.sh and run.sh --other-fold with the
+# two other `--asymmetry` settings (`source-clip`: one offset per clip;
+# `style`: the report's, the style's symmetric statistics alone), then takes
+# that walk straight and then turn (or turn, then walk), joined from held-out
+# dataset-2 clips and restyled with each setting (study style_asymmetry_along).
+# About 7 minutes; run after run.sh and run.sh --other-fold, whose eval.json
+# files are the default's side. The other settings' reports (about 1 MB each)
+# stay in ${RUNS_DIR:-/tmp/style-asymmetry}.
 source "$(dirname "$0")/setup.sh"
 require_fold_model
 RUNS=${RUNS_DIR:-/tmp/style-asymmetry}
 mkdir -p "$RUNS"
 for ASYMMETRY in style source-clip; do
-  COMMON=(--asymmetry "$ASYMMETRY" --sources walk,walk-turn-left,walk-turn-right --styles walk
-    --classifier-contents "$WALKS")
-  "$BIN/style_eval" "${COMMON[@]}" --json "$RUNS/eval-$ASYMMETRY-last.json" \
-    "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
-  "$BIN/style_eval" "${COMMON[@]}" --held-out first --model "$FOLD_MODEL" \
-    --json "$RUNS/eval-$ASYMMETRY-first.json" "$DATA/dataset-1" "$DATA/dataset-2" > /dev/null
+  "$MOCAP" style eval "$DATA/dataset-1" "$DATA/dataset-2" "${PAIRS[@]}" --asymmetry "$ASYMMETRY" \
+    --json > "$RUNS/eval-$ASYMMETRY-last.json"
+  "$MOCAP" style eval "$DATA/dataset-1" "$DATA/dataset-2" "${PAIRS[@]}" --asymmetry "$ASYMMETRY" \
+    --held-out first --model "$FOLD_MODEL" --json > "$RUNS/eval-$ASYMMETRY-first.json"
 done
 {
   python3 bench/style/asymmetry_table.py "$RUNS"
@@ -31,9 +25,9 @@ done
   echo
   echo "Shipped fold (last take held out, the shipped model):"
   echo
-  "$BIN/asymmetry_along" "$DATA/dataset-2" 2> /dev/null
+  "$BIN/style_asymmetry_along" "$DATA/dataset-2" 2> /dev/null
   echo
   echo "Other fold (first take held out, its model):"
   echo
-  "$BIN/asymmetry_along" "$DATA/dataset-2" --held-out first --model "$FOLD_MODEL" 2> /dev/null
+  "$BIN/style_asymmetry_along" "$DATA/dataset-2" --held-out first --model "$FOLD_MODEL" 2> /dev/null
 } > "$OUT/asymmetry.md"

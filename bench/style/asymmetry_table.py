@@ -3,7 +3,7 @@ source's left-right asymmetry kept along the take (the default, eval.json),
 kept as one offset per clip (`--asymmetry source-clip`) and not kept
 (`--asymmetry style`, the report's method).
 
-Usage: python3 bench/style/asymmetry_table.py RUNS_DIR > bench/style/out/asymmetry.md
+Usage: python3 bench/style/asymmetry_table.py RUNS_DIR   (the first part of bench/style/out/asymmetry.md)
 RUNS_DIR holds eval-{style,source-clip}-{last,first}.json.
 """
 import pathlib
@@ -15,7 +15,7 @@ OUT = pathlib.Path(__file__).resolve().parent / "out"
 RUNS_DIR = pathlib.Path(sys.argv[1])
 RUNS = {
     "style (report)": (RUNS_DIR / "eval-style-last.json", RUNS_DIR / "eval-style-first.json"),
-    "source-clip (session 16)": (
+    "source-clip": (
         RUNS_DIR / "eval-source-clip-last.json",
         RUNS_DIR / "eval-source-clip-first.json",
     ),

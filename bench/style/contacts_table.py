@@ -1,10 +1,10 @@
-"""Table of `run.sh --contacts`: elastic and fixed patches with each root,
-without and with the foot-contact cleanup, side by side (shipped fold,
-judge seed 1).
+"""Table of `run.sh --contacts` (bench/style/out/contacts-table.md): elastic and
+fixed patches with each root, without and with the foot-contact cleanup, side by
+side (shipped fold, judge seed 1).
 
-Usage: python3 bench/style/contacts_table.py bench/style/out > bench/style/out/contacts-table.md
-The folder holds run.sh's eval.json and eval-root-source.json and the
---contacts runs' eval-contacts-default-root.json, eval-contacts.json,
+Usage: python3 bench/style/contacts_table.py bench/style/out RUNS_DIR > bench/style/out/contacts-table.md
+bench/style/out holds run.sh's eval.json; RUNS_DIR holds eval-root-source.json and
+the --contacts runs' eval-contacts-default-root.json, eval-contacts.json,
 eval-root-from-feet.json and eval-root-from-feet-contacts.json.
 """
 import json
@@ -14,6 +14,7 @@ import sys
 from reports import method_row
 
 out = pathlib.Path(sys.argv[1])
+runs = pathlib.Path(sys.argv[2])
 # (file, root, cleanup) in the order of the table.
 RUNS = [
     ("eval.json", "default", False),
@@ -30,7 +31,10 @@ print(
     "| foot skating | feet beyond real reach | jitter | distance ratio |"
 )
 print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-reports = {name: json.loads((out / name).read_text()) for name, _, _ in RUNS}
+reports = {
+    name: json.loads(((out if name == "eval.json" else runs) / name).read_text())
+    for name, _, _ in RUNS
+}
 for data_set in ["dataset-1", "dataset-2"]:
     for name, root, cleanup in RUNS:
         for method in METHODS:

@@ -18,7 +18,7 @@ FOLDS = ["last", "first"]
 SEEDS = [1, 2, 3]
 SETS = ["dataset-1", "dataset-2"]
 PATCHES = sorted({int(re.match(r"eval-p(\d+)-", p.name).group(1)) for p in root.glob("eval-p*.json")})
-# The methods in the reports, in the order style_eval writes them.
+# The methods in the reports, in the order `mocap style eval` writes them.
 METHODS = [m["method"] for m in json.loads(next(root.glob("eval-p*.json")).read_text())["sets"][0]["methods"]]
 
 

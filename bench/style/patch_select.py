@@ -2,13 +2,14 @@
 fold's pairs and judged on the other fold's.
 
 Usage: python3 bench/style/patch_select.py RUNS_DIR > bench/style/out/patch-select.md
-RUNS_DIR holds eval-p{P}-{last,first}.json (style_eval reports, judge seed 1).
+RUNS_DIR holds eval-p{P}-{last,first}.json (`mocap style eval --json` reports,
+judge seed 1).
 
 The rule, fixed before the runs: on the choosing fold, the P with the highest
 style accuracy of elastic patches, averaged over dataset-1 and dataset-2,
 among the P whose content accuracy is at least 90% on both sets (the issue's
-content target); ties go to the P closest to the default 32. The grid was
-24-56 when the rule was fixed; 64 and 72 were added after 56 came out best.
+content target); ties go to the P closest to the reference length 32. The
+rule was fixed for the grid 24-56; 64 and 72 look past its edge.
 """
 import json
 import pathlib
@@ -20,7 +21,8 @@ from reports import method_row, pooled
 root = pathlib.Path(sys.argv[1])
 FOLDS = ["last", "first"]
 SETS = ["dataset-1", "dataset-2"]
-DEFAULT = 32
+# The length each choice is compared with.
+REFERENCE = 32
 runs = {}
 for path in root.glob("eval-p*-*.json"):
     p, fold = re.fullmatch(r"eval-p(\d+)-(\w+)\.json", path.name).groups()
@@ -80,22 +82,22 @@ def choose_and_judge(candidates, title):
     chosen = {}
     for choose, judge in [("last", "first"), ("first", "last")]:
         valid = [p for p in candidates if score(p, choose) is not None]
-        best = max(valid, key=lambda p: (score(p, choose), -abs(p - DEFAULT)))
+        best = max(valid, key=lambda p: (score(p, choose), -abs(p - REFERENCE)))
         chosen[judge] = best
         for s in SETS:
             print(f"| {choose} | {best} | {judge} | {s} | {cells([row(best, judge, s)])} |")
-            print(f"| (default) | {DEFAULT} | {judge} | {s} | {cells([row(DEFAULT, judge, s)])} |")
-    print("\nBoth folds pooled: each fold judged with the P chosen on the other, against the default.\n")
+            print(f"| (reference) | {REFERENCE} | {judge} | {s} | {cells([row(REFERENCE, judge, s)])} |")
+    print("\nBoth folds pooled: each fold judged with the P chosen on the other, against the reference length.\n")
     print(f"| P | set {HEADER}")
     print("| --- " * 8 + "|")
     for s in SETS:
         print(f"| chosen on the other fold | {s} | {cells([row(chosen[f], f, s) for f in FOLDS])} |")
-        print(f"| {DEFAULT} | {s} | {cells([row(DEFAULT, f, s) for f in FOLDS])} |")
+        print(f"| {REFERENCE} | {s} | {cells([row(REFERENCE, f, s) for f in FOLDS])} |")
 
 
 def keeps_every_pair(p):
     return all(
-        row(p, f, s)["pairs"] == row(DEFAULT, f, s)["pairs"] for f in FOLDS for s in SETS
+        row(p, f, s)["pairs"] == row(REFERENCE, f, s)["pairs"] for f in FOLDS for s in SETS
     )
 
 
@@ -103,7 +105,7 @@ choose_and_judge(PATCHES, "The rule as fixed before the runs")
 kept = [p for p in PATCHES if keeps_every_pair(p)]
 choose_and_judge(
     kept,
-    "Only lengths that keep every pair (added after the runs: "
+    "Only lengths that keep every pair ("
     f"{', '.join(str(p) for p in PATCHES if p not in kept) or 'none'} "
     "refuse clips shorter than two patches, and some pairs drop out)",
 )

@@ -1,4 +1,4 @@
-"""Reading the JSON reports of `style_eval` for the table scripts of
+"""Reading the JSON reports of `mocap style eval --json` for the table scripts of
 bench/style (asymmetry_table.py, judges_table.py): one method's row of one
 set, and figures pooled over several reports by their number of pairs."""
 import json

@@ -1,19 +1,14 @@
 #!/usr/bin/env bash
-# Why restyled dataset-2 turns were read as straight walks (bench/results/style.md,
-# "The other fold" and "Turns kept"): the six right turns of the shipped fold that
-# the active walk (dataset-2_walk_active_031) made into "walks" before session 16,
-# restyled again with the shipped model and `mocap style apply` (elastic patches,
-# as the evaluation), with the source's left-right asymmetry kept (the default)
-# and without it (`--asymmetry style`, the report's method), then placed between
-# real straight walks and real right turns on the pose values that tell those
-# apart most (example feature_contrast); the sources the same way. Then the
-# feet's sideways offset split into its slow change along the clip and the
-# swing within each stride (example turn_swing), for real walks and turns,
-# the sources and the outputs of every asymmetry setting. About a minute.
-# Output: bench/style/out/turn-cues.md.
+# Reproduces bench/style/out/turn-cues.md (bench/results/style.md, "Turns kept
+# along the take"): six dataset-2 right turns restyled with the active walk
+# (dataset-2_walk_active_031) by `mocap style apply`, with the source's
+# left-right asymmetry kept (the default) and without it (`--asymmetry style`,
+# the report's method), placed between real straight walks and real right turns
+# on the pose values that tell those apart most (study style_feature_contrast),
+# their sources the same way; then the feet's sideways offset split into its
+# slow change along the clip and the swing within each stride (study
+# style_turn_swing). About a minute.
 source "$(dirname "$0")/setup.sh"
-cargo build -q --profile test -p mocap-cli
-MOCAP=$CARGO_TARGET_DIR/debug/mocap
 D2=$DATA/dataset-2
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
@@ -29,17 +24,17 @@ done
 {
   echo "## Outputs (six right turns restyled with dataset-2_walk_active_031)"
   echo
-  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/source/*.bvh --top 10
+  "$BIN/style_feature_contrast" "$D2" walk-turn-right walk "$TMP"/source/*.bvh --top 10
   echo
   echo "## The same without the source's asymmetry (--asymmetry style, the report's method)"
   echo
-  "$BIN/feature_contrast" "$D2" walk-turn-right walk "$TMP"/style/*.bvh --top 10
+  "$BIN/style_feature_contrast" "$D2" walk-turn-right walk "$TMP"/style/*.bvh --top 10
   echo
   echo "## Their sources"
   echo
-  "$BIN/feature_contrast" "$D2" walk-turn-right walk "${SOURCES[@]}" --top 10
+  "$BIN/style_feature_contrast" "$D2" walk-turn-right walk "${SOURCES[@]}" --top 10
   echo
   echo "## The feet's sideways offset: its slow change along the clip, and the swing within a stride"
   echo
-  "$BIN/turn_swing" "$D2" "$D2/dataset-2_walk_active_031.bvh" "${SOURCES[@]}"
+  "$BIN/style_turn_swing" "$D2" "$D2/dataset-2_walk_active_031.bvh" "${SOURCES[@]}"
 } > "$OUT/turn-cues.md"
