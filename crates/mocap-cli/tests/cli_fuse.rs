@@ -15,10 +15,7 @@ fn mocap(args: &[&str]) -> Output {
 }
 
 fn sample() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../samples/dataset-1_walk_normal_001.bvh")
-        .display()
-        .to_string()
+    mocap_testdata::sample_walk().display().to_string()
 }
 
 fn stderr(out: &Output) -> String {
@@ -47,7 +44,7 @@ fn simulated(extra: &[&str]) -> (tempfile::TempDir, PathBuf) {
         "3",
         "--seed",
         "2",
-        "--out",
+        "--output",
     ]
     .into_iter()
     .map(String::from)
@@ -125,9 +122,9 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
             &s(&sim.join("truth.calib.toml")),
             "--body",
             &s(&sim.join("body.json")),
-            "--out",
+            "-o",
             &s(&fused),
-            "--out",
+            "-o",
             &s(&bvh),
             "--json",
         ]
@@ -160,33 +157,7 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
     };
     let bvh_as_jsonl = d.join("bvh.jsonl");
     let fk = mocap_core::forward_kinematics(&motion);
-    let names = [
-        "SpineBase",
-        "SpineMid",
-        "Neck",
-        "Head",
-        "ShoulderLeft",
-        "ElbowLeft",
-        "WristLeft",
-        "HandLeft",
-        "ShoulderRight",
-        "ElbowRight",
-        "WristRight",
-        "HandRight",
-        "HipLeft",
-        "KneeLeft",
-        "AnkleLeft",
-        "FootLeft",
-        "HipRight",
-        "KneeRight",
-        "AnkleRight",
-        "FootRight",
-        "SpineShoulder",
-        "HandTipLeft",
-        "ThumbLeft",
-        "HandTipRight",
-        "ThumbRight",
-    ];
+    let names = mocap_core::bodymap::KINECT_V2_JOINTS.map(|(name, _)| name);
     let index: Vec<usize> = names
         .iter()
         .map(|n| motion.skeleton().find(n).unwrap())
@@ -216,13 +187,13 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
     let rig = d.join("rig.toml");
     let mut args = vec!["fuse".to_string(), "calibrate".into()];
     args.extend(recordings(&sim));
-    args.extend(["--out", &s(&rig), "--json"].map(String::from));
+    args.extend(["-o", &s(&rig), "--json"].map(String::from));
     let calibrated = json(&mocap(&args.iter().map(String::as_str).collect::<Vec<_>>()));
     assert_eq!(calibrated["sensors"].as_array().unwrap().len(), 2);
     let body = d.join("measured.json");
     let mut args = vec!["fuse".to_string(), "measure".into()];
     args.extend(recordings(&sim));
-    args.extend(["--out", &s(&body)].map(String::from));
+    args.extend(["-o", &s(&body)].map(String::from));
     let out = mocap(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(out.status.success(), "{}", stderr(&out));
     let mut args = vec!["fuse".to_string(), "run".into()];
@@ -235,7 +206,7 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
             &s(&body),
             "--method",
             "report",
-            "--out",
+            "-o",
             &s(&d.join("body-calibrated.bvh")),
             "--json",
         ]
@@ -261,9 +232,9 @@ fn serve_and_send_over_loopback() {
             &s(&sim.join("body.json")),
             "--listen",
             "127.0.0.1:0",
-            "--out",
+            "-o",
             &s(&live),
-            "--out",
+            "-o",
             &s(&live_bvh),
             "--idle-exit",
             "1",
@@ -325,7 +296,7 @@ fn calibrate_one_room_scan_against_another() {
         &s(&sim.join("sensor-1.ply")),
         "--pairs",
         &s(&sim.join("pairs-0-1.txt")),
-        "--out",
+        "-o",
         &s(&rig),
         "--json",
     ]);
@@ -336,7 +307,7 @@ fn calibrate_one_room_scan_against_another() {
         .unwrap()
         .is_empty());
     // Sensor 1's pose relative to sensor 0, against the truth.
-    use mocap_fuse::calib::Calibration;
+    use mocap_fuse::Calibration;
     let truth = Calibration::read(&sim.join("truth.calib.toml")).unwrap();
     let relative = |c: &Calibration| c.get(0).unwrap().inverse().then_after(c.get(1).unwrap());
     let expected = relative(&truth);
@@ -358,7 +329,7 @@ fn eval_on_ntu_files_without_ground_truth() {
         .collect();
     let mut args = vec!["fuse", "eval"];
     args.extend(files.iter().map(String::as_str));
-    args.extend(["--json", "-"]);
+    args.push("--json");
     let reports = json(&mocap(&args));
     let report = &reports[0];
     assert_eq!(report["sensors"].as_array().unwrap().len(), 3);
@@ -381,6 +352,7 @@ fn eval_on_ntu_files_without_ground_truth() {
 #[test]
 fn eval_on_a_bvh_take_compares_methods_with_the_truth() {
     let plots = tempfile::tempdir().unwrap();
+    let markdown = plots.path().join("eval.md");
     let out = mocap(&[
         "fuse",
         "eval",
@@ -390,11 +362,16 @@ fn eval_on_a_bvh_take_compares_methods_with_the_truth() {
         "--seeds",
         "1",
         "--json",
-        "-",
+        "--markdown",
+        &s(&markdown),
         "--plots",
         plots.path().to_str().unwrap(),
     ]);
     let report = json(&out);
+    // The Markdown tables go to their file, the JSON to standard output.
+    let tables = std::fs::read_to_string(&markdown).unwrap();
+    assert!(tables.starts_with("Command: `mocap fuse eval "), "{tables}");
+    assert!(tables.contains("| sensors | method |"), "{tables}");
     let results = report["results"].as_array().unwrap();
     // Per-joint errors average to the method's MPJPE, and are drawn.
     for r in results {
@@ -443,7 +420,7 @@ fn errors_name_the_problem() {
         [
             "--calib",
             &s(&partial),
-            "--out",
+            "-o",
             &s(&dir.path().join("x.jsonl")),
         ]
         .map(String::from),
@@ -462,7 +439,7 @@ fn errors_name_the_problem() {
         &recordings(&sim)[0],
         "--calib",
         &s(&sim.join("truth.calib.toml")),
-        "--out",
+        "-o",
         &s(&dir.path().join("x.csv")),
     ]);
     assert_eq!(out.status.code(), Some(1));
@@ -474,7 +451,7 @@ fn errors_name_the_problem() {
         "fuse",
         "measure",
         &s(&bad),
-        "--out",
+        "-o",
         &s(&dir.path().join("b.json")),
     ]);
     assert_eq!(out.status.code(), Some(1));
@@ -486,7 +463,7 @@ fn errors_name_the_problem() {
         &recordings(&sim)[0],
         "--calib",
         "c.toml",
-        "--out",
+        "-o",
         "x.jsonl",
         "--method",
         "magic",

@@ -21,13 +21,10 @@ use std::time::Duration;
 use anyhow::{anyhow, Context};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::Vec3;
-use mocap_fuse::bvh::{fit_error, fused_to_motion, poses_to_motion, regular_poses, BvhOptions};
-use mocap_fuse::fusion::{FusedFrame, FusionOptions};
-use mocap_fuse::kinect::JOINT_COUNT;
-use mocap_fuse::net::{self, MemorySink, SendOptions, ServeOptions, ServeReport};
-use mocap_fuse::offline::{views_at, SensorStreams};
-use mocap_fuse::sim::{
-    center_truth, measure_person, simulate, truth_from_motion, GroundTruth, SimulationOptions,
+use mocap_fuse::{
+    fit_error, fused_to_motion, poses_to_motion, regular_poses, simulate_capture, views_at,
+    BvhOptions, FusedFrame, FusionOptions, MemorySink, SendOptions, SendReport, SensorFrame,
+    SensorStreams, ServeOptions, ServeReport, SimulatedCapture, SimulationOptions, JOINT_COUNT,
 };
 use mocap_view::{plot_lines, render_files, LinePlot, RenderOptions, Series};
 
@@ -44,10 +41,10 @@ fn pose_error(a: &[Vec3; JOINT_COUNT], b: &[Vec3; JOINT_COUNT]) -> f64 {
 
 /// Runs the fusion server in a thread and replays `frames` to it over UDP.
 fn stream_over_udp(
-    frames: &[mocap_fuse::recording::SensorFrame],
+    frames: &[SensorFrame],
     serve: ServeOptions,
     speed: f64,
-) -> anyhow::Result<(ServeReport, Vec<FusedFrame>, net::SendReport)> {
+) -> anyhow::Result<(ServeReport, Vec<FusedFrame>, SendReport)> {
     let (bound_tx, bound_rx) = tokio::sync::oneshot::channel::<SocketAddr>();
     let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
     let server = std::thread::Builder::new()
@@ -55,7 +52,7 @@ fn stream_over_udp(
         .spawn(
             move || -> mocap_core::Result<(ServeReport, Vec<FusedFrame>)> {
                 let mut sink = MemorySink::default();
-                let report = net::runtime()?.block_on(net::serve(
+                let report = mocap_fuse::runtime()?.block_on(mocap_fuse::serve(
                     serve,
                     &mut sink,
                     async {
@@ -68,7 +65,7 @@ fn stream_over_udp(
         )
         .context("cannot start the fusion server thread")?;
     let sent = match bound_rx.blocking_recv() {
-        Ok(addr) => net::send_blocking(
+        Ok(addr) => mocap_fuse::send_blocking(
             frames,
             SendOptions {
                 to: addr,
@@ -94,16 +91,17 @@ fn stream_over_udp(
 pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResult {
     let options = context.options;
     let motion = read_bvh(&options.sample)?;
-    let mut truth: GroundTruth = truth_from_motion(&motion, None)?;
     let simulation = SimulationOptions {
         sensors: options.sensors,
         seed: options.seed,
         ..SimulationOptions::default()
     };
-    center_truth(&mut truth, simulation.treadmill_above);
-    let sim = simulate(&truth, &simulation);
-    // The person, measured from another capture (other seed) of the take.
-    let body = measure_person(&truth, &simulation);
+    // The person is measured from another capture (other seed) of the take.
+    let SimulatedCapture {
+        simulation: sim,
+        body,
+    } = simulate_capture(&motion, None, &simulation)?;
+    let truth = &sim.truth;
     let calibration = sim.calibration();
     let frames: Vec<_> = sim
         .sensors

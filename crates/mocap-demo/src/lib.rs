@@ -513,7 +513,7 @@ pub(crate) fn units_per_metre(motion: &mocap_core::Motion) -> f32 {
         low = low.min(y);
         high = high.max(y);
     }
-    mocap_fuse::sim::guess_units_per_metre(high - low)
+    mocap_fuse::guess_units_per_metre(high - low)
 }
 
 #[cfg(test)]

@@ -8,11 +8,11 @@
 
 use std::time::Duration;
 
-use mocap_fuse::body::{BodyModel, MeasureOptions};
-use mocap_fuse::fusion::FusionOptions;
-use mocap_fuse::net::{runtime, send, serve, JsonlSink, SendOptions, ServeOptions};
-use mocap_fuse::recording::SensorFrame;
-use mocap_fuse::sim::{center_truth, simulate, truth_from_motion, SimulationOptions};
+use mocap_fuse::{
+    center_truth, runtime, send, serve, simulate, truth_from_motion, BodyModel, FusionOptions,
+    JsonlSink, MeasureOptions, SendOptions, SensorFrame, SensorModel, ServeOptions,
+    SimulationOptions,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &truth,
         &SimulationOptions {
             sensors: senders,
-            model: mocap_fuse::sim::SensorModel {
+            model: SensorModel {
                 drop_rate: (0.0, 0.0),
                 ..Default::default()
             },

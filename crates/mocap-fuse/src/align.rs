@@ -1,6 +1,8 @@
 //! Estimating rigid transforms: from point pairs (Kabsch/Umeyama), between
 //! point clouds (ICP), and from the body itself seen by two sensors.
 
+use std::path::{Path, PathBuf};
+
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use mocap_core::rotation::{Quat, Vec3};
@@ -638,7 +640,7 @@ pub struct BodySensorReport {
     pub inliers: usize,
     /// RMS distance of the inliers (m).
     pub rms: f64,
-    /// Frames whose left/right labels were settled ([`settle_labels`]) in
+    /// Frames whose left/right labels were settled (`settle_labels`) in
     /// this sensor and in the reference, out of the frames paired.
     pub settled_frames: usize,
     pub paired_frames: usize,
@@ -663,44 +665,18 @@ pub struct BodyCalibration {
     pub sensors: Vec<BodySensorReport>,
 }
 
-/// Which way a skeleton really faces, from cues that do not depend on its
-/// left/right labels (horizontal, camera or world space, y up): the feet
-/// point forward (ankle to foot) and bent knees stick out forward (knee
-/// ahead of the line from hip to ankle). Each leg counts when its joints
-/// are Tracked, whatever its label; the vector's length grows with how much
-/// the cues say (metres), zero when they say nothing.
-pub fn label_free_forward(joints: &[JointObservation; JOINT_COUNT]) -> Vec3 {
-    use crate::kinect::joint::*;
-    let tracked = |n: usize| joints[n].state == TrackingState::Tracked;
-    let at = |n: usize| joints[n].position;
-    let mut forward = Vec3::ZERO;
-    for (hip, knee, ankle, foot) in [
-        (HIP_LEFT, KNEE_LEFT, ANKLE_LEFT, FOOT_LEFT),
-        (HIP_RIGHT, KNEE_RIGHT, ANKLE_RIGHT, FOOT_RIGHT),
-    ] {
-        if tracked(ankle) && tracked(foot) {
-            forward += (at(foot) - at(ankle)).with_y(0.0);
-        }
-        if tracked(hip) && tracked(knee) && tracked(ankle) {
-            // Twice the knee's offset: a knee bent by 30 degrees sticks out
-            // about 10 cm, as long as a foot.
-            forward += 2.0 * (at(knee) - (at(hip) + at(ankle)) * 0.5).with_y(0.0);
-        }
-    }
-    forward
-}
-
 /// Settles the left/right labels of one sensor's frames (in time order) in
 /// its own camera space.
 ///
 /// A Kinect seeing a person from behind still labels the skeleton as if the
 /// person faced it, so its labelled skeleton always seems to face the camera.
-/// Where the labelled facing and [`label_free_forward`] disagree, the labels
-/// are swapped. One frame's cues are noisy (a foot in swing points down, a
-/// straight knee says nothing), but whether a sensor sees the back changes
-/// only as the person turns, so the agreement is summed over the frames
-/// within `window` seconds. `None` for frames where the sum does not clearly
-/// say (below `margin` of its largest possible value).
+/// Where the labelled facing and [`crate::fusion::label_free_forward`]
+/// disagree, the labels are swapped. One frame's cues are noisy (a foot in
+/// swing points down, a straight knee says nothing), but whether a sensor
+/// sees the back changes only as the person turns, so the agreement is
+/// summed over the frames within `window` seconds. `None` for frames where
+/// the sum does not clearly say (below `margin` of its largest possible
+/// value).
 pub fn settle_labels(
     frames: &[crate::recording::SensorFrame],
     window: f64,
@@ -709,7 +685,7 @@ pub fn settle_labels(
     let cues: Vec<(f64, f32, f32)> = frames
         .iter()
         .map(|f| {
-            let forward = label_free_forward(&f.joints);
+            let forward = crate::fusion::label_free_forward(&f.joints);
             let labelled = crate::fusion::facing_of(&f.joints.map(|j| j.position));
             (f.timestamp, labelled.dot(forward), forward.length())
         })
@@ -823,7 +799,7 @@ fn robust_fit(
 /// different hands, and since a body is nearly mirror-symmetric, the fit
 /// finds the sensor turned by about 180 degrees, with many inliers. So the
 /// labels are first settled frame by frame in each sensor's own view, by
-/// the feet and knees ([`settle_labels`]); only frames settled in both sensors
+/// the feet and knees (`settle_labels`); only frames settled in both sensors
 /// are paired. As a check, the fit is also made with this sensor's labels
 /// all mirrored, and the hypothesis with more inliers is kept (reported in
 /// [`BodySensorReport::mirrored_inliers`]).
@@ -1054,6 +1030,171 @@ fn refine_by_consensus(
     }
 }
 
+/// What `mocap fuse calibrate` reports of a calibration from the body.
+#[derive(Debug, Clone, Serialize)]
+pub struct BodyCalibrationReport {
+    /// The calibration file written.
+    pub calibration: PathBuf,
+    /// The sensor whose camera frame is the world.
+    pub reference: u16,
+    pub sensors: Vec<BodySensorReport>,
+}
+
+impl BodyCalibrationReport {
+    /// Degrees of doubt about a sensor's turn about the vertical beyond which
+    /// the person moved too little for a sure calibration.
+    pub const UNSURE_DEGREES: f64 = 5.0;
+
+    /// Whether some sensor's turn is known only to more than
+    /// [`Self::UNSURE_DEGREES`].
+    pub fn is_unsure(&self) -> bool {
+        self.sensors
+            .iter()
+            .any(|s| s.yaw_uncertainty_degrees > Self::UNSURE_DEGREES)
+    }
+}
+
+/// `mocap fuse calibrate REC...`: calibrates the sensors of the recordings
+/// from the person all of them see ([`calibrate_from_body`]) and writes the
+/// calibration to `output`.
+pub fn calibrate_recordings(
+    recordings: &[PathBuf],
+    options: &BodyCalibrationOptions,
+    output: &Path,
+) -> Result<BodyCalibrationReport> {
+    let frames = crate::recording::read_recordings(recordings)?;
+    let streams = SensorStreams::new(frames);
+    let found = calibrate_from_body(&streams, options)?;
+    found.calibration.write(output)?;
+    Ok(BodyCalibrationReport {
+        calibration: output.to_path_buf(),
+        reference: found.reference,
+        sensors: found.sensors,
+    })
+}
+
+/// Two room scans to calibrate one against the other
+/// ([`calibrate_scans`]).
+#[derive(Debug, Clone, Default)]
+pub struct ScanPair {
+    /// The reference's scan and the scan of the sensor to place (PLY, camera
+    /// space, metres).
+    pub scans: [PathBuf; 2],
+    /// Point pairs picked in both scans ([`read_point_pairs`]) for the rough
+    /// start.
+    pub pairs: Option<PathBuf>,
+    /// A calibration holding both sensors (for example from the body) for
+    /// the rough start.
+    pub initial: Option<PathBuf>,
+    /// The sensor ids of the two scans; by default the last number in each
+    /// file name (`sensor-2.ply` is 2).
+    pub ids: Option<[u16; 2]>,
+}
+
+/// The result of [`calibrate_scans`].
+#[derive(Debug, Clone)]
+pub struct ScanCalibration {
+    /// The reference's id and the id of the sensor placed.
+    pub ids: [u16; 2],
+    /// ICP started from the identity (neither point pairs nor an initial
+    /// calibration): it works only for scans taken from nearly the same
+    /// place.
+    pub from_identity: bool,
+    pub fit: PointCalibration,
+}
+
+/// The sensor id in a file name: its last number (`sensor-2.ply` is 2).
+fn id_in_name(path: &Path) -> Option<u16> {
+    let stem = path.file_stem()?.to_str()?;
+    let digits: String = stem
+        .chars()
+        .rev()
+        .skip_while(|c| !c.is_ascii_digit())
+        .take_while(|c| c.is_ascii_digit())
+        .collect();
+    digits.chars().rev().collect::<String>().parse().ok()
+}
+
+/// `mocap fuse calibrate --points A.ply B.ply`: places the second scan's
+/// sensor in the world of the calibration file `output`
+/// ([`calibrate_from_points`]). An existing `output` is updated; a new one
+/// takes the first scan's sensor as the world.
+pub fn calibrate_scans(scans: &ScanPair, output: &Path) -> Result<ScanCalibration> {
+    let [a_path, b_path] = &scans.scans;
+    let (a_id, b_id) = match scans.ids {
+        Some([a, b]) => (a, b),
+        None => match (id_in_name(a_path), id_in_name(b_path)) {
+            (Some(a), Some(b)) => (a, b),
+            _ => {
+                return Err(Error::Invalid(format!(
+                    "cannot tell the sensor ids from the names {} and {}: give --ids A B",
+                    a_path.display(),
+                    b_path.display()
+                )))
+            }
+        },
+    };
+    if a_id == b_id {
+        return Err(Error::Invalid(format!(
+            "both scans are of sensor {a_id}: give --ids A B"
+        )));
+    }
+    let a = crate::ply::read_ply_points(a_path)?;
+    let b = crate::ply::read_ply_points(b_path)?;
+    let pairs = match &scans.pairs {
+        Some(p) => read_point_pairs(p)?,
+        None => Vec::new(),
+    };
+    let initial = match &scans.initial {
+        Some(path) => {
+            let c = Calibration::read(path)?;
+            let (Some(wa), Some(wb)) = (c.get(a_id), c.get(b_id)) else {
+                return Err(Error::Invalid(format!(
+                    "{}: --initial must hold both sensor {a_id} and sensor {b_id}",
+                    path.display()
+                )));
+            };
+            Some(wa.inverse().then_after(wb))
+        }
+        None => None,
+    };
+    let from_identity = pairs.is_empty() && initial.is_none();
+    let fit = calibrate_from_points(&a, &b, &pairs, initial, &Default::default())?;
+    // Place B in the world of the output file (A's pose there, or A as the
+    // world when the file is new).
+    let mut calibration = if output.exists() {
+        Calibration::read(output)?
+    } else {
+        Calibration::default()
+    };
+    let world_from_a = match calibration.get(a_id) {
+        Some(t) => *t,
+        None => {
+            calibration.set(SensorPose {
+                id: a_id,
+                transform: RigidTransform::IDENTITY,
+                method: Some("reference".into()),
+                rms_residual: None,
+                pairs: None,
+            });
+            RigidTransform::IDENTITY
+        }
+    };
+    calibration.set(SensorPose {
+        id: b_id,
+        transform: world_from_a.then_after(&fit.transform),
+        method: Some("icp".into()),
+        rms_residual: Some(fit.icp.rms),
+        pairs: Some(fit.icp.pairs),
+    });
+    calibration.write(output)?;
+    Ok(ScanCalibration {
+        ids: [a_id, b_id],
+        from_identity,
+        fit,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1177,7 +1318,7 @@ mod tests {
         // wandered off by a metre here).
         let room = crate::sim::room_points(0.06, 1);
         let model = crate::sim::SensorModel::default();
-        let still = crate::sim::GroundTruth {
+        let still = crate::kinect::GroundTruth {
             fps: 30.0,
             frames: vec![[Vec3::new(0.0, 1.0, 0.0); JOINT_COUNT]; 2],
         };

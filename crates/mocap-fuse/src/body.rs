@@ -310,7 +310,7 @@ impl BodyModel {
 /// vertex (the knee for the knee angle...) is turned through a grid of 9
 /// values per limited degree of freedom, the rest of the skeleton held in its
 /// rest pose, and the angle measured on the Kinect joints of each sample
-/// ([`crate::sim::truth_from_motion`]); the range is the smallest and largest
+/// ([`crate::kinect::truth_from_motion`]); the range is the smallest and largest
 /// angle seen. Angles whose vertex joint has no rotation limits stay `None`.
 /// Only the vertex joint turns, so an angle that two joints make together
 /// (clavicle and shoulder) gets the range of the one at the vertex.
@@ -353,7 +353,7 @@ pub fn ranges_from_limits(
             let q = limits.axis_frame * local * limits.axis_frame.inverse();
             motion.set_local_rotation(i, joint, q);
         }
-        let truth = crate::sim::truth_from_motion(&motion, Some(1.0))?;
+        let truth = crate::kinect::truth_from_motion(&motion, Some(1.0))?;
         let angles: Vec<f32> = truth
             .frames
             .iter()
@@ -367,6 +367,31 @@ pub fn ranges_from_limits(
         }
     }
     Ok(ranges)
+}
+
+/// Joint ranges from the limits of the ASF skeleton in the file `asf`
+/// ([`ranges_from_limits`]).
+pub fn ranges_from_asf(asf: &std::path::Path) -> mocap_core::Result<Vec<Option<AngleRange>>> {
+    use mocap_core::io::asf_amc::{read_asf, LengthUnit};
+    ranges_from_limits(&read_asf(asf)?.to_skeleton(LengthUnit::Centimetres)?)
+}
+
+/// `mocap fuse measure`: the person measured from recordings
+/// ([`BodyModel::measure`]), with the joint ranges taken from the limits of
+/// an ASF skeleton instead when `limits` is given ([`ranges_from_asf`]),
+/// written to `output`.
+pub fn measure_recordings(
+    recordings: &[std::path::PathBuf],
+    limits: Option<&std::path::Path>,
+    output: &std::path::Path,
+) -> mocap_core::Result<BodyModel> {
+    let frames = crate::recording::read_recordings(recordings)?;
+    let mut body = BodyModel::measure(frames.iter().map(|f| &f.joints), MeasureOptions::default());
+    if let Some(asf) = limits {
+        body.ranges = ranges_from_asf(asf)?;
+    }
+    body.write(output)?;
+    Ok(body)
 }
 
 /// The `q`-quantile of `samples` (sorted in place; nearest rank).

@@ -26,11 +26,10 @@ use crate::body::{BodyModel, MeasureOptions};
 use crate::calib::Calibration;
 use crate::confidence::BoneLengthFunction;
 use crate::fusion::{Fuser, FusionOptions, OneEuroParams};
+use crate::kinect::GroundTruth;
 use crate::kinect::{joint::*, JOINT_COUNT};
 use crate::offline::{fuse_streams, views_at, SensorStreams};
-use crate::sim::{
-    center_truth, measure_person, simulate, truth_from_motion, GroundTruth, SimulationOptions,
-};
+use crate::sim::{simulate_capture, SimulatedCapture, SimulationOptions};
 
 /// How the sensors' poses are known in the evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -54,10 +53,10 @@ pub struct EvalOptions {
     pub simulation: SimulationOptions,
     /// Length units per metre of the BVH files; guessed when `None`.
     pub units_per_metre: Option<f32>,
-    /// Joint ranges from ASF limits ([`crate::body::ranges_from_limits`]):
-    /// when given, two more methods use them instead of the measured ranges.
-    #[serde(skip)]
-    pub limit_ranges: Option<Vec<Option<crate::body::AngleRange>>>,
+    /// An ASF skeleton whose joint limits give joint ranges
+    /// ([`crate::body::ranges_from_asf`]): when given, two more methods use
+    /// them instead of the measured ranges.
+    pub limits: Option<PathBuf>,
 }
 
 impl Default for EvalOptions {
@@ -69,7 +68,7 @@ impl Default for EvalOptions {
             calibration: CalibrationSource::Truth,
             simulation: SimulationOptions::default(),
             units_per_metre: None,
-            limit_ranges: None,
+            limits: None,
         }
     }
 }
@@ -273,11 +272,15 @@ pub fn evaluate_with(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<EvalReport> {
     let files = collect_bvh_files(&options.inputs)?;
+    let limit_ranges = match &options.limits {
+        Some(asf) => Some(crate::body::ranges_from_asf(asf)?),
+        None => None,
+    };
     let mut methods = methods();
     // Methods with the ASF ranges: marked by this prefix, run with a body
     // whose ranges are replaced.
     const ASF: &str = "ASF ranges: ";
-    if options.limit_ranges.is_some() {
+    if limit_ranges.is_some() {
         let mut report_swap = FusionOptions::report();
         report_swap.swap_repair = true;
         methods.push((
@@ -294,8 +297,6 @@ pub fn evaluate_with(
     let mut clips = Vec::new();
     for path in &files {
         let motion = mocap_core::io::bvh::read_bvh(path)?;
-        let mut truth = truth_from_motion(&motion, options.units_per_metre)?;
-        center_truth(&mut truth, options.simulation.treadmill_above);
         clips.push(
             path.file_name()
                 .unwrap_or_default()
@@ -307,9 +308,11 @@ pub fn evaluate_with(
                 let mut sim_options = options.simulation;
                 sim_options.sensors = k;
                 sim_options.seed = seed.wrapping_mul(1_000_003).wrapping_add(k as u64);
-                let sim = simulate(&truth, &sim_options);
-                // The person, measured from another capture of the take.
-                let body = measure_person(&truth, &sim_options);
+                let SimulatedCapture {
+                    simulation: sim,
+                    body,
+                } = simulate_capture(&motion, options.units_per_metre, &sim_options)?;
+                let truth = &sim.truth;
                 let streams =
                     SensorStreams::new(sim.sensors.iter().flat_map(|s| s.frames.iter().cloned()));
                 for s in &sim.sensors {
@@ -319,7 +322,7 @@ pub fn evaluate_with(
                         }
                         frames_seen += 1;
                         let truth_pose = truth.at(f.timestamp);
-                        let face = crate::sim::facing(&truth_pose);
+                        let face = crate::fusion::facing_of(&truth_pose);
                         let to = ((s.pose.translation - truth_pose[SPINE_BASE])
                             * Vec3::new(1.0, 0.0, 1.0))
                         .normalize_or_zero();
@@ -378,7 +381,7 @@ pub fn evaluate_with(
                     truth_jitter.0 += jitter(&poses);
                     truth_jitter.1 += 1;
                 }
-                let asf_body = options.limit_ranges.as_ref().map(|ranges| BodyModel {
+                let asf_body = limit_ranges.as_ref().map(|ranges| BodyModel {
                     ranges: ranges.clone(),
                     ..body.clone()
                 });
@@ -388,8 +391,8 @@ pub fn evaluate_with(
                         _ => &body,
                     };
                     let m = match method {
-                        Some(o) => run_method(&streams, &calibration, &truth, body_here, *o),
-                        None => best_single(&streams, &calibration, &truth, &body),
+                        Some(o) => run_method(&streams, &calibration, truth, body_here, *o),
+                        None => best_single(&streams, &calibration, truth, &body),
                     };
                     let Some(m) = m else {
                         continue;
@@ -448,6 +451,153 @@ pub fn evaluate_with(
             }
         }),
     })
+}
+
+/// What `mocap fuse eval` measured: BVH takes against their ground truth,
+/// or real recordings by bone-length consistency. As JSON it is the report
+/// itself.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum Evaluation {
+    /// Simulated sensors on BVH takes ([`evaluate`]).
+    Truth(EvalReport),
+    /// Recordings without ground truth, one report per take
+    /// ([`evaluate_consistency`]).
+    Consistency(Vec<ConsistencyReport>),
+}
+
+impl Evaluation {
+    /// The report as Markdown, headed by the command that made it.
+    pub fn markdown(&self, command: &str) -> String {
+        match self {
+            Evaluation::Truth(report) => report_markdown(report, command),
+            Evaluation::Consistency(reports) => consistency_markdown(reports, command),
+        }
+    }
+}
+
+/// Whether a file is a recording (`.skeleton`, `.jsonl`) rather than a take.
+fn is_recording(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("skeleton") || e.eq_ignore_ascii_case("jsonl"))
+}
+
+/// `mocap fuse eval`: BVH takes or folders (`options.inputs`) are evaluated
+/// against their ground truth ([`evaluate_with`]); recordings (NTU
+/// `.skeleton`, one file per camera of a take, or `.jsonl`) by bone-length
+/// consistency ([`evaluate_recordings`]). Calls `progress(done, total)` after
+/// each take.
+pub fn evaluate_inputs(
+    options: &EvalOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Evaluation> {
+    let recordings = options.inputs.iter().filter(|p| is_recording(p)).count();
+    if recordings == options.inputs.len() {
+        Ok(Evaluation::Consistency(evaluate_recordings(
+            &options.inputs,
+            progress,
+        )?))
+    } else if recordings == 0 {
+        Ok(Evaluation::Truth(evaluate_with(options, progress)?))
+    } else {
+        Err(Error::Invalid(
+            "give either BVH takes (simulated sensors, ground truth) or recordings (.skeleton, .jsonl), not both".into(),
+        ))
+    }
+}
+
+/// The consistency evaluation ([`evaluate_consistency`]) of each take of the
+/// recordings ([`group_takes`]) with the `state`, `report` and `best`
+/// fusion methods at 30 fused frames per second. Calls `progress(done,
+/// total)` after each take.
+pub fn evaluate_recordings(
+    recordings: &[PathBuf],
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<ConsistencyReport>> {
+    let takes = group_takes(recordings);
+    let methods: Vec<(String, FusionOptions)> = ["state", "report", "best"]
+        .iter()
+        .map(|m| Ok((format!("fused ({m})"), FusionOptions::preset(m)?)))
+        .collect::<Result<_>>()?;
+    let mut reports = Vec::new();
+    for (take, files) in &takes {
+        let frames = crate::recording::read_recordings(files)?;
+        reports.push(evaluate_consistency(take, frames, &methods, 30.0)?);
+        progress(reports.len(), takes.len());
+    }
+    Ok(reports)
+}
+
+/// One chart of [`EvalReport::per_joint_charts`]: grouped bars of each
+/// joint's mean position error, one series per method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerJointChart {
+    pub sensors: usize,
+    pub title: String,
+    /// The Kinect v2 joint names, in SDK order.
+    pub joints: Vec<String>,
+    pub series: Vec<PerJointSeries>,
+}
+
+/// One method's bars in a [`PerJointChart`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerJointSeries {
+    /// The method and its MPJPE.
+    pub label: String,
+    /// Mean error per joint (mm).
+    pub values: Vec<f32>,
+    /// Standard deviation over the runs per joint (mm).
+    pub errors: Vec<f32>,
+}
+
+impl EvalReport {
+    /// Per sensor count, each joint's mean position error for the best
+    /// single sensor, the report's baseline and method, and the best
+    /// version, with the standard deviation over runs (what `mocap fuse eval
+    /// --plots` draws).
+    pub fn per_joint_charts(&self) -> Vec<PerJointChart> {
+        let shown = |name: &str| {
+            name == "best single sensor"
+                || name.starts_with("state only (")
+                || name.contains("(report method)")
+                || name.starts_with("best:")
+        };
+        let joints: Vec<String> = crate::kinect::JOINT_NAMES
+            .iter()
+            .map(|name| name.to_string())
+            .collect();
+        let mut counts: Vec<usize> = self.results.iter().map(|r| r.sensors).collect();
+        counts.dedup();
+        let mut charts = Vec::new();
+        for k in counts {
+            let series: Vec<PerJointSeries> = self
+                .results
+                .iter()
+                .filter(|r| {
+                    r.sensors == k && shown(&r.method) && r.per_joint_mm.len() == joints.len()
+                })
+                .map(|r| PerJointSeries {
+                    label: format!("{} ({:.1} mm)", r.method, r.mpjpe_mm),
+                    values: r.per_joint_mm.iter().map(|&v| v as f32).collect(),
+                    errors: r.per_joint_sd_mm.iter().map(|&v| v as f32).collect(),
+                })
+                .collect();
+            if series.is_empty() {
+                continue;
+            }
+            charts.push(PerJointChart {
+                sensors: k,
+                title: format!(
+                    "position error per joint, {k} sensors ({} takes x {} seeds; bars: sd over runs)",
+                    self.clips.len(),
+                    self.seeds.len()
+                ),
+                joints: joints.clone(),
+                series,
+            });
+        }
+        charts
+    }
 }
 
 const LEG_BONES: [usize; 4] = [KNEE_LEFT, ANKLE_LEFT, KNEE_RIGHT, ANKLE_RIGHT];
@@ -609,14 +759,6 @@ pub fn report_markdown(report: &EvalReport, command: &str) -> String {
         }
     }
     s
-}
-
-/// Writes the report's Markdown to `path` atomically.
-pub fn write_report(path: &Path, report: &EvalReport, command: &str) -> Result<()> {
-    mocap_core::io::atomic::write_bytes_atomically(
-        path,
-        report_markdown(report, command).as_bytes(),
-    )
 }
 
 /// The bones whose length consistency is reported: the torso, arms and

@@ -2,8 +2,8 @@
 //!
 //! The paper's fusion is the confidence-weighted mean of each joint,
 //! `J_n = sum_k C_kn J_kn / sum_k C_kn` ([`crate::confidence`]). On top of it
-//! [`FusionOptions`] can switch on what we found to help on top (each
-//! measured separately in the evaluation):
+//! [`FusionOptions`] can switch on additions that help (each measured
+//! separately in the evaluation):
 //! - **left/right swap repair**: a Kinect that sees the person from behind
 //!   still believes it sees them from the front and swaps left and right. The
 //!   person's facing is found from cues that do not depend on the labels (the
@@ -65,7 +65,7 @@ pub struct FusionOptions {
     #[serde(default)]
     pub depth_reference: Option<f32>,
     /// Swap repair also reads bent knees as a label-free cue to facing
-    /// ([`crate::align::label_free_forward`]), not only the feet.
+    /// (`label_free_forward`), not only the feet.
     #[serde(default)]
     pub knee_cue: bool,
     /// Learn each sensor's reliability: per sensor, joint and tracking
@@ -260,6 +260,32 @@ pub fn swap_left_right(
     std::array::from_fn(|n| joints[MIRROR[n]])
 }
 
+/// Which way a skeleton really faces, from cues that do not depend on its
+/// left/right labels (horizontal, camera or world space, y up): the feet
+/// point forward (ankle to foot) and bent knees stick out forward (knee
+/// ahead of the line from hip to ankle). Each leg counts when its joints
+/// are Tracked, whatever its label; the vector's length grows with how much
+/// the cues say (metres), zero when they say nothing.
+pub fn label_free_forward(joints: &[JointObservation; JOINT_COUNT]) -> Vec3 {
+    let tracked = |n: usize| joints[n].state == TrackingState::Tracked;
+    let at = |n: usize| joints[n].position;
+    let mut forward = Vec3::ZERO;
+    for (hip, knee, ankle, foot) in [
+        (HIP_LEFT, KNEE_LEFT, ANKLE_LEFT, FOOT_LEFT),
+        (HIP_RIGHT, KNEE_RIGHT, ANKLE_RIGHT, FOOT_RIGHT),
+    ] {
+        if tracked(ankle) && tracked(foot) {
+            forward += (at(foot) - at(ankle)).with_y(0.0);
+        }
+        if tracked(hip) && tracked(knee) && tracked(ankle) {
+            // Twice the knee's offset: a knee bent by 30 degrees sticks out
+            // about 10 cm, as long as a foot.
+            forward += 2.0 * (at(knee) - (at(hip) + at(ankle)) * 0.5).with_y(0.0);
+        }
+    }
+    forward
+}
+
 impl Fuser {
     pub fn new(options: FusionOptions, body: BodyModel) -> Fuser {
         Fuser {
@@ -400,7 +426,7 @@ impl Fuser {
         let mut forward = Vec3::ZERO;
         for v in views {
             if self.options.knee_cue {
-                forward += crate::align::label_free_forward(&v.joints).normalize_or_zero();
+                forward += label_free_forward(&v.joints).normalize_or_zero();
                 continue;
             }
             for (ankle, foot) in [(ANKLE_LEFT, FOOT_LEFT), (ANKLE_RIGHT, FOOT_RIGHT)] {

@@ -34,9 +34,10 @@ use tokio::net::UdpSocket;
 
 use crate::body::BodyModel;
 use crate::calib::Calibration;
-use crate::fusion::{FusedFrame, Fuser, FusionOptions, SensorView};
+use crate::fusion::{Fuser, FusionOptions, SensorView};
 use crate::offline::sample_stream;
-use crate::recording::{JointObservation, SensorFrame};
+use crate::output::{FrameSink, FusedOutputs, OutputFiles, OutputReport};
+use crate::recording::{read_recordings, JointObservation, SensorFrame};
 
 /// The datagram magic and version.
 pub const MAGIC: &[u8; 4] = b"MCF1";
@@ -215,94 +216,6 @@ impl Timeline {
                 }
             }
         }
-    }
-}
-
-/// Where fused frames go.
-pub trait FrameSink {
-    fn write(&mut self, frame: &FusedFrame) -> Result<()>;
-    /// Flushes and closes the output.
-    fn finish(&mut self) -> Result<()>;
-}
-
-/// Fused frames as JSON lines (`{"t":..,"joints":[[x,y,z],..],"confidence":[..]}`),
-/// written to a temporary file that replaces the output on `finish`.
-pub struct JsonlSink {
-    path: PathBuf,
-    tmp: PathBuf,
-    out: Option<std::io::BufWriter<std::fs::File>>,
-}
-
-impl JsonlSink {
-    pub fn create(path: PathBuf) -> Result<JsonlSink> {
-        let tmp = path.with_extension(format!("jsonl.{}.tmp", std::process::id()));
-        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        Ok(JsonlSink {
-            path,
-            tmp,
-            out: Some(std::io::BufWriter::new(file)),
-        })
-    }
-}
-
-/// One fused frame as a JSON line (no newline).
-pub fn fused_frame_json(frame: &FusedFrame) -> String {
-    use std::fmt::Write as _;
-    let mut s = format!("{{\"t\":{},\"joints\":[", frame.time);
-    for (n, p) in frame.joints.iter().enumerate() {
-        let _ = write!(
-            s,
-            "{}[{:.4},{:.4},{:.4}]",
-            if n > 0 { "," } else { "" },
-            p.x,
-            p.y,
-            p.z
-        );
-    }
-    s.push_str("],\"confidence\":[");
-    for (n, c) in frame.confidence.iter().enumerate() {
-        let _ = write!(s, "{}{:.3}", if n > 0 { "," } else { "" }, c);
-    }
-    s.push_str("]}");
-    s
-}
-
-impl FrameSink for JsonlSink {
-    fn write(&mut self, frame: &FusedFrame) -> Result<()> {
-        use std::io::Write;
-        if let Some(out) = self.out.as_mut() {
-            writeln!(out, "{}", fused_frame_json(frame)).map_err(|e| Error::io(&self.tmp, e))?;
-        }
-        Ok(())
-    }
-
-    fn finish(&mut self) -> Result<()> {
-        use std::io::Write;
-        if let Some(mut out) = self.out.take() {
-            out.flush().map_err(|e| Error::io(&self.tmp, e))?;
-            let file = out
-                .into_inner()
-                .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
-            file.sync_all().map_err(|e| Error::io(&self.tmp, e))?;
-            std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
-        }
-        Ok(())
-    }
-}
-
-/// Keeps fused frames in memory (for a BVH written at the end, and tests).
-#[derive(Default)]
-pub struct MemorySink {
-    pub frames: Vec<FusedFrame>,
-}
-
-impl FrameSink for MemorySink {
-    fn write(&mut self, frame: &FusedFrame) -> Result<()> {
-        self.frames.push(frame.clone());
-        Ok(())
-    }
-    fn finish(&mut self) -> Result<()> {
-        Ok(())
     }
 }
 
@@ -552,12 +465,73 @@ pub fn send_blocking(frames: &[SensorFrame], options: SendOptions) -> Result<Sen
     runtime()?.block_on(send(frames, options))
 }
 
+/// What `mocap fuse serve` serves: the server's settings
+/// ([`ServeOptions`]) with its calibration and body read from files, and the
+/// files fused frames go to.
+#[derive(Debug, Clone)]
+pub struct ServeFilesOptions {
+    /// The calibration file (every sensor's pose).
+    pub calibration: PathBuf,
+    /// The person's body file.
+    pub body: PathBuf,
+    pub outputs: OutputFiles,
+    pub listen: SocketAddr,
+    pub fusion: FusionOptions,
+    pub fps: f64,
+    pub wait: f64,
+    pub sensor_timeout: f64,
+    pub duration: Option<Duration>,
+    pub idle_exit: Option<Duration>,
+}
+
+/// What [`serve_files`] did.
+#[derive(Debug, Clone, Serialize)]
+pub struct ServeFilesReport {
+    pub server: ServeReport,
+    pub outputs: Vec<OutputReport>,
+}
+
+/// `mocap fuse serve`: the fusion server ([`serve_blocking_with`]) until
+/// Ctrl-C, `duration` or `idle_exit`, writing the output files.
+pub fn serve_files(
+    options: ServeFilesOptions,
+    on_listening: impl FnOnce(SocketAddr),
+) -> Result<ServeFilesReport> {
+    let calibration = Calibration::read(&options.calibration)?;
+    let body = BodyModel::read(&options.body)?;
+    let mut outputs = FusedOutputs::open(&options.outputs, body.clone(), options.fps)?;
+    let server_options = ServeOptions {
+        listen: options.listen,
+        calibration,
+        body,
+        fusion: options.fusion,
+        fps: options.fps,
+        wait: options.wait,
+        sensor_timeout: options.sensor_timeout,
+        duration: options.duration,
+        idle_exit: options.idle_exit,
+    };
+    let server = serve_blocking_with(server_options, &mut outputs, on_listening)?;
+    Ok(ServeFilesReport {
+        server,
+        outputs: outputs.reports().to_vec(),
+    })
+}
+
+/// `mocap fuse send`: sends the recordings' frames to a fusion server
+/// ([`send_blocking`]).
+pub fn send_files(recordings: &[PathBuf], options: SendOptions) -> Result<SendReport> {
+    let frames = read_recordings(recordings)?;
+    send_blocking(&frames, options)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::body::MeasureOptions;
     use crate::calib::{RigidTransform, SensorPose};
     use crate::kinect::{TrackingState, JOINT_COUNT};
+    use crate::output::MemorySink;
     use mocap_core::rotation::Vec3;
 
     fn frame(sensor: u16, seq: u64) -> SensorFrame {

@@ -9,12 +9,17 @@
 //! tracking states, or its nearest frame within half a period.
 
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
-use crate::calib::Calibration;
-use crate::fusion::{FusedFrame, Fuser, SensorView};
-use crate::kinect::JOINT_COUNT;
-use crate::recording::{JointObservation, SensorFrame};
 use mocap_core::{Error, Result};
+use serde::Serialize;
+
+use crate::body::{BodyModel, MeasureOptions};
+use crate::calib::Calibration;
+use crate::fusion::{FusedFrame, Fuser, FusionOptions, SensorView};
+use crate::kinect::JOINT_COUNT;
+use crate::output::{FrameSink, FusedOutputs, OutputFiles, OutputReport};
+use crate::recording::{read_recordings, JointObservation, SensorFrame};
 
 /// Each sensor's frames in time order (duplicates removed).
 #[derive(Debug, Clone, Default)]
@@ -194,7 +199,7 @@ pub fn fuse_recordings(
     calibration: &Calibration,
     fuser: &mut Fuser,
     fps: f64,
-    sink: &mut dyn crate::net::FrameSink,
+    sink: &mut dyn FrameSink,
 ) -> Result<usize> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(Error::Invalid(format!(
@@ -217,6 +222,54 @@ pub fn fuse_recordings(
     }
     sink.finish()?;
     Ok(fused.len())
+}
+
+/// What `mocap fuse run` fuses, and where to.
+#[derive(Debug, Clone)]
+pub struct FuseFilesOptions {
+    /// Recordings (`.jsonl`, NTU `.skeleton`) of the sensors.
+    pub recordings: Vec<PathBuf>,
+    /// The calibration file (every sensor's pose).
+    pub calibration: PathBuf,
+    /// The person's body file; `None` measures the person from the
+    /// recordings themselves.
+    pub body: Option<PathBuf>,
+    pub outputs: OutputFiles,
+    pub fusion: FusionOptions,
+    /// Fused frames per second.
+    pub fps: f64,
+}
+
+/// What [`fuse_files`] did.
+#[derive(Debug, Clone, Serialize)]
+pub struct FuseFilesReport {
+    pub fused_frames: usize,
+    pub sensors: Vec<u16>,
+    pub body_measured_from_recordings: bool,
+    pub outputs: Vec<OutputReport>,
+}
+
+/// `mocap fuse run`: fuses recordings with their calibration and the
+/// person's body ([`fuse_recordings`]) into the output files.
+pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
+    let calibration = Calibration::read(&options.calibration)?;
+    let frames = read_recordings(&options.recordings)?;
+    let mut sensors: Vec<u16> = frames.iter().map(|f| f.sensor).collect();
+    sensors.sort();
+    sensors.dedup();
+    let body = match &options.body {
+        Some(path) => BodyModel::read(path)?,
+        None => BodyModel::measure(frames.iter().map(|f| &f.joints), MeasureOptions::default()),
+    };
+    let mut outputs = FusedOutputs::open(&options.outputs, body.clone(), options.fps)?;
+    let mut fuser = Fuser::new(options.fusion, body);
+    let count = fuse_recordings(frames, &calibration, &mut fuser, options.fps, &mut outputs)?;
+    Ok(FuseFilesReport {
+        fused_frames: count,
+        sensors,
+        body_measured_from_recordings: options.body.is_none(),
+        outputs: outputs.reports().to_vec(),
+    })
 }
 
 #[cfg(test)]

@@ -1,8 +1,10 @@
-//! Where fused frames go: JSON lines written as they come, and BVH files
-//! written at the end (a skeleton needs the whole take to be fitted).
+//! Where fused frames go ([`FrameSink`]): JSON lines written as they come
+//! ([`JsonlSink`], one line per frame by [`fused_frame_json`]), memory
+//! ([`MemorySink`]), and BVH files written at the end (a skeleton needs the
+//! whole take to be fitted), several at once ([`FusedOutputs`]).
 //!
 //! The format of each output is chosen by its extension: `.jsonl` (or
-//! `.json`) for fused frames as JSON lines ([`crate::net::fused_frame_json`]),
+//! `.json`) for fused frames as JSON lines ([`fused_frame_json`]),
 //! `.bvh` for a motion on a fitted skeleton ([`crate::bvh`]).
 
 use std::path::{Path, PathBuf};
@@ -15,7 +17,94 @@ use crate::bvh::{
     fit_error, fused_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError,
 };
 use crate::fusion::FusedFrame;
-use crate::net::{FrameSink, JsonlSink};
+
+/// Where fused frames go.
+pub trait FrameSink {
+    fn write(&mut self, frame: &FusedFrame) -> Result<()>;
+    /// Flushes and closes the output.
+    fn finish(&mut self) -> Result<()>;
+}
+
+/// Fused frames as JSON lines (`{"t":..,"joints":[[x,y,z],..],"confidence":[..]}`),
+/// written to a temporary file that replaces the output on `finish`.
+pub struct JsonlSink {
+    path: PathBuf,
+    tmp: PathBuf,
+    out: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl JsonlSink {
+    pub fn create(path: PathBuf) -> Result<JsonlSink> {
+        let tmp = path.with_extension(format!("jsonl.{}.tmp", std::process::id()));
+        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        Ok(JsonlSink {
+            path,
+            tmp,
+            out: Some(std::io::BufWriter::new(file)),
+        })
+    }
+}
+
+/// One fused frame as a JSON line (no newline).
+pub fn fused_frame_json(frame: &FusedFrame) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!("{{\"t\":{},\"joints\":[", frame.time);
+    for (n, p) in frame.joints.iter().enumerate() {
+        let _ = write!(
+            s,
+            "{}[{:.4},{:.4},{:.4}]",
+            if n > 0 { "," } else { "" },
+            p.x,
+            p.y,
+            p.z
+        );
+    }
+    s.push_str("],\"confidence\":[");
+    for (n, c) in frame.confidence.iter().enumerate() {
+        let _ = write!(s, "{}{:.3}", if n > 0 { "," } else { "" }, c);
+    }
+    s.push_str("]}");
+    s
+}
+
+impl FrameSink for JsonlSink {
+    fn write(&mut self, frame: &FusedFrame) -> Result<()> {
+        use std::io::Write;
+        if let Some(out) = self.out.as_mut() {
+            writeln!(out, "{}", fused_frame_json(frame)).map_err(|e| Error::io(&self.tmp, e))?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        use std::io::Write;
+        if let Some(mut out) = self.out.take() {
+            out.flush().map_err(|e| Error::io(&self.tmp, e))?;
+            let file = out
+                .into_inner()
+                .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
+            file.sync_all().map_err(|e| Error::io(&self.tmp, e))?;
+            std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
+        }
+        Ok(())
+    }
+}
+
+/// Keeps fused frames in memory (for a BVH written at the end, and tests).
+#[derive(Default)]
+pub struct MemorySink {
+    pub frames: Vec<FusedFrame>,
+}
+
+impl FrameSink for MemorySink {
+    fn write(&mut self, frame: &FusedFrame) -> Result<()> {
+        self.frames.push(frame.clone());
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<()> {
+        Ok(())
+    }
+}
 
 /// The format of an output file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -54,6 +143,19 @@ pub struct OutputReport {
     pub fit_error: Option<FitError>,
 }
 
+/// The files fused frames go to (`mocap fuse run` and `serve`), and how the
+/// BVH ones are made.
+#[derive(Debug, Clone)]
+pub struct OutputFiles {
+    /// `.jsonl` files (fused joints as JSON lines) and `.bvh` files (a motion
+    /// on a fitted skeleton), by extension ([`OutputFormat::of`]).
+    pub paths: Vec<PathBuf>,
+    /// Length units per metre of the BVH files (100: centimetres).
+    pub bvh_units_per_metre: f32,
+    /// Where the BVH skeleton's bone lengths come from.
+    pub bvh_lengths: BoneLengthSource,
+}
+
 /// Fused frames to several outputs at once.
 pub struct FusedOutputs {
     jsonl: Vec<(PathBuf, JsonlSink)>,
@@ -88,6 +190,16 @@ impl FusedOutputs {
             lengths: BoneLengthSource::Fused,
             reports: Vec::new(),
         })
+    }
+
+    /// Opens `files` ([`FusedOutputs::create`]) for frames at `fps`.
+    pub fn open(files: &OutputFiles, body: BodyModel, fps: f64) -> Result<Self> {
+        let bvh_options = BvhOptions {
+            units_per_metre: files.bvh_units_per_metre,
+            fps,
+        };
+        Ok(FusedOutputs::create(&files.paths, body, bvh_options)?
+            .with_bone_lengths(files.bvh_lengths))
     }
 
     /// Where the BVH outputs' bone lengths come from (default: the fused

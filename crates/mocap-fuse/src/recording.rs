@@ -219,6 +219,21 @@ pub fn read_any_recording(path: &Path, default_sensor: u16) -> Result<Vec<Sensor
     }
 }
 
+/// Reads the sensor frames of several recordings ([`read_any_recording`];
+/// the `i`th file's default sensor id is `i`). Fails when they hold no frame.
+pub fn read_recordings(paths: &[std::path::PathBuf]) -> Result<Vec<SensorFrame>> {
+    let mut frames = Vec::new();
+    for (i, path) in paths.iter().enumerate() {
+        frames.extend(read_any_recording(path, i as u16)?);
+    }
+    if frames.is_empty() {
+        return Err(Error::Invalid(
+            "the recordings hold no sensor frames".into(),
+        ));
+    }
+    Ok(frames)
+}
+
 /// The camera number in an NTU file name (`...C002...` gives 2).
 pub fn ntu_camera_of(path: &Path) -> Option<u16> {
     let name = path.file_stem()?.to_str()?;

@@ -40,9 +40,8 @@
 //! milliseconds. The values are our reading of those reports, not fitted to a
 //! data set: see `docs/fuse-simulator.md`.
 
-use mocap_core::bodymap::{kinect_v2_joint, BodyMap, BodyPart};
 use mocap_core::rotation::{Quat, Vec3};
-use mocap_core::{forward_kinematics, Error, Motion, Result};
+use mocap_core::{Error, Motion, Result};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
@@ -50,7 +49,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::body::{BodyModel, MeasureOptions};
 use crate::calib::{Calibration, RigidTransform, SensorPose};
-use crate::kinect::{joint::*, TrackingState, JOINT_COUNT, MIRROR};
+use crate::fusion::facing_of;
+use crate::kinect::{joint::*, truth_from_motion, GroundTruth, TrackingState, JOINT_COUNT, MIRROR};
 use crate::recording::{JointObservation, SensorFrame};
 
 /// The sensor model; see the module documentation for the sources.
@@ -143,151 +143,6 @@ impl Default for SimulationOptions {
     }
 }
 
-/// The ground truth: Kinect joints in world space (metres, y up) per frame.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GroundTruth {
-    pub fps: f64,
-    pub frames: Vec<[Vec3; JOINT_COUNT]>,
-}
-
-impl GroundTruth {
-    /// The pose at time `t` (seconds), linearly interpolated; clamped to the
-    /// take.
-    pub fn at(&self, t: f64) -> [Vec3; JOINT_COUNT] {
-        let x = (t * self.fps).max(0.0);
-        let i = (x.floor() as usize).min(self.frames.len() - 1);
-        let j = (i + 1).min(self.frames.len() - 1);
-        let a = (x - i as f64).clamp(0.0, 1.0) as f32;
-        std::array::from_fn(|n| self.frames[i][n].lerp(self.frames[j][n], a))
-    }
-
-    pub fn duration(&self) -> f64 {
-        (self.frames.len().saturating_sub(1)) as f64 / self.fps
-    }
-}
-
-/// Length units per metre of a motion, from the standing height of its
-/// first frame (head above the lower ankle): centimetres (Bandai), metres,
-/// or inches.
-pub fn guess_units_per_metre(height_in_units: f32) -> f32 {
-    if height_in_units > 60.0 && height_in_units < 260.0 {
-        100.0
-    } else if height_in_units > 25.0 && height_in_units <= 60.0 {
-        // Some exporters write inches (a 1.7 m person is 67 in), others
-        // a tenth of a metre... inches is the common case.
-        39.37
-    } else {
-        1.0
-    }
-}
-
-/// The Kinect v2 joints of a motion: joints located with
-/// [`BodyMap::detect`]; the hands, hand tips and thumbs (which rigs like
-/// Bandai's lack) are placed along the forearm beyond the wrist (8 cm, 16 cm,
-/// and 5 cm plus 3 cm sideways), the feet 12 cm ahead of the ankle when the
-/// rig has no toe. Positions are converted to metres.
-pub fn truth_from_motion(motion: &Motion, units_per_metre: Option<f32>) -> Result<GroundTruth> {
-    let skeleton = motion.skeleton();
-    let map = BodyMap::detect(skeleton)?;
-    let poses = forward_kinematics(motion);
-    let joint_of = |n: usize| -> Option<usize> {
-        BodyPart::ALL
-            .iter()
-            .find(|&&p| kinect_v2_joint(p) == Some(n))
-            .and_then(|&p| map.joint(p))
-    };
-    let mapped: Vec<Option<usize>> = (0..JOINT_COUNT).map(joint_of).collect();
-    for n in [
-        SPINE_BASE,
-        HEAD,
-        SHOULDER_LEFT,
-        ELBOW_LEFT,
-        WRIST_LEFT,
-        SHOULDER_RIGHT,
-        ELBOW_RIGHT,
-        WRIST_RIGHT,
-        HIP_LEFT,
-        KNEE_LEFT,
-        ANKLE_LEFT,
-        HIP_RIGHT,
-        KNEE_RIGHT,
-        ANKLE_RIGHT,
-    ] {
-        if mapped[n].is_none() {
-            return Err(Error::Invalid(format!(
-                "the skeleton has no joint for Kinect's {}",
-                crate::kinect::JOINT_NAMES[n]
-            )));
-        }
-    }
-    let units = match units_per_metre {
-        Some(u) => u,
-        None => {
-            let head = poses.position(0, mapped[HEAD].unwrap());
-            let ankle = poses
-                .position(0, mapped[ANKLE_LEFT].unwrap())
-                .y
-                .min(poses.position(0, mapped[ANKLE_RIGHT].unwrap()).y);
-            guess_units_per_metre(head.y - ankle)
-        }
-    };
-    let mut frames = Vec::with_capacity(motion.frame_count());
-    for f in 0..motion.frame_count() {
-        let at = |j: usize| poses.position(f, j) / units;
-        let mut p = [Vec3::ZERO; JOINT_COUNT];
-        for n in 0..JOINT_COUNT {
-            if let Some(j) = mapped[n] {
-                p[n] = at(j);
-            }
-        }
-        // Joints some rigs lack: midpoints and points beyond the wrist.
-        if mapped[SPINE_MID].is_none() {
-            p[SPINE_MID] = p[SPINE_BASE].lerp(p[SPINE_SHOULDER], 0.5);
-        }
-        if mapped[SPINE_SHOULDER].is_none() {
-            p[SPINE_SHOULDER] = p[SHOULDER_LEFT].lerp(p[SHOULDER_RIGHT], 0.5);
-        }
-        if mapped[NECK].is_none() {
-            p[NECK] = p[SPINE_SHOULDER].lerp(p[HEAD], 0.4);
-        }
-        for (elbow, wrist, hand, tip, thumb) in [
-            (ELBOW_LEFT, WRIST_LEFT, HAND_LEFT, HAND_TIP_LEFT, THUMB_LEFT),
-            (
-                ELBOW_RIGHT,
-                WRIST_RIGHT,
-                HAND_RIGHT,
-                HAND_TIP_RIGHT,
-                THUMB_RIGHT,
-            ),
-        ] {
-            let along = (p[wrist] - p[elbow]).normalize_or(Vec3::NEG_Y);
-            let side = along.cross(Vec3::Y).normalize_or(Vec3::X);
-            if mapped[hand].is_none() {
-                p[hand] = p[wrist] + along * 0.08;
-            }
-            p[tip] = p[wrist] + along * 0.16;
-            p[thumb] = p[wrist] + along * 0.05 + side * 0.03;
-        }
-        for (knee, ankle, foot, hip_here, hip_other) in [
-            (KNEE_LEFT, ANKLE_LEFT, FOOT_LEFT, HIP_LEFT, HIP_RIGHT),
-            (KNEE_RIGHT, ANKLE_RIGHT, FOOT_RIGHT, HIP_RIGHT, HIP_LEFT),
-        ] {
-            if mapped[foot].is_none() {
-                let forward = (p[hip_other] - p[hip_here])
-                    .cross(Vec3::Y)
-                    .normalize_or(Vec3::Z);
-                let _ = knee;
-                p[foot] = p[ankle] + forward * 0.12 - Vec3::Y * 0.05;
-            }
-        }
-        frames.push(p);
-    }
-    Ok(GroundTruth {
-        fps: motion.fps(),
-        frames,
-    })
-}
-
 /// A capsule of the body: the segment between two joints, with a radius.
 const CAPSULES: [(usize, usize, f32); 17] = [
     (SPINE_BASE, SPINE_MID, 0.13),
@@ -369,12 +224,6 @@ pub fn is_occluded(pose: &[Vec3; JOINT_COUNT], n: usize, eye: Vec3) -> bool {
         }
         segment_distance(eye, end, pose[a], pose[b]) < r
     })
-}
-
-/// The direction the body faces (horizontal): from the hip and shoulder
-/// lines, pointing forward.
-pub fn facing(pose: &[Vec3; JOINT_COUNT]) -> Vec3 {
-    crate::fusion::facing_of(pose)
 }
 
 /// One simulated sensor.
@@ -480,6 +329,36 @@ pub fn center_truth(truth: &mut GroundTruth, treadmill_above: Option<f32>) {
             *p -= shift;
         }
     }
+}
+
+/// A take watched by simulated sensors, with the person measured beforehand.
+#[derive(Debug, Clone)]
+pub struct SimulatedCapture {
+    /// The sensors' recordings and the ground truth they watched (centred,
+    /// see [`center_truth`]).
+    pub simulation: Simulation,
+    /// The person measured from a second capture of the take
+    /// ([`measure_person`]).
+    pub body: BodyModel,
+}
+
+/// The simulation pipeline, as `mocap fuse simulate`, `mocap fuse eval` and
+/// the demo run it: the Kinect joints of `motion` ([`truth_from_motion`],
+/// `units_per_metre` guessed when `None`), centred and put on a treadmill
+/// when they travel far ([`center_truth`] with
+/// `options.treadmill_above`), watched by `options.sensors` sensors
+/// ([`simulate`]), and the person measured from a second capture
+/// ([`measure_person`]).
+pub fn simulate_capture(
+    motion: &Motion,
+    units_per_metre: Option<f32>,
+    options: &SimulationOptions,
+) -> Result<SimulatedCapture> {
+    let mut truth = truth_from_motion(motion, units_per_metre)?;
+    center_truth(&mut truth, options.treadmill_above);
+    let simulation = simulate(&truth, options);
+    let body = measure_person(&truth, options);
+    Ok(SimulatedCapture { simulation, body })
 }
 
 /// The person as `mocap fuse measure` would measure them beforehand: bone
@@ -622,7 +501,7 @@ fn simulate_sensor(
         }
         // Seen from behind: Kinect believes the person faces it and swaps
         // left and right.
-        let face = facing(&world);
+        let face = facing_of(&world);
         let to_sensor = ((eye - world[SPINE_BASE]) * Vec3::new(1.0, 0.0, 1.0)).normalize_or_zero();
         if face != Vec3::ZERO && face.dot(to_sensor) < cos_behind {
             joints = std::array::from_fn(|n| joints[MIRROR[n]]);
@@ -800,7 +679,7 @@ pub fn write_simulation(
                 sensors: Vec::new(),
                 swapped: Vec::new(),
             };
-            writeln!(w, "{}", crate::net::fused_frame_json(&frame))?;
+            writeln!(w, "{}", crate::output::fused_frame_json(&frame))?;
         }
         Ok(())
     })?;
@@ -850,6 +729,62 @@ pub fn write_simulation(
     Ok(files)
 }
 
+/// What `mocap fuse simulate` reports of one simulated sensor.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulatedSensorReport {
+    pub id: u16,
+    pub frames: usize,
+    pub latency_seconds: f64,
+    pub drop_rate: f64,
+}
+
+/// What [`simulate_to_folder`] made.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulationReport {
+    pub sensors: Vec<SimulatedSensorReport>,
+    /// Frames of the ground truth, and their rate.
+    pub truth_frames: usize,
+    pub fps: f64,
+    pub files: SimulationFiles,
+}
+
+/// `mocap fuse simulate`: `options.sensors` sensors watching the BVH take at
+/// `take` ([`simulate_capture`], `units_per_metre` guessed when `None`),
+/// written to the folder `output` ([`write_simulation`], with NTU
+/// `.skeleton` files when `ntu`).
+pub fn simulate_to_folder(
+    take: &std::path::Path,
+    output: &std::path::Path,
+    options: &SimulationOptions,
+    units_per_metre: Option<f32>,
+    ntu: bool,
+) -> Result<SimulationReport> {
+    if options.sensors == 0 {
+        return Err(Error::Invalid(
+            "a simulation needs at least one sensor".into(),
+        ));
+    }
+    let motion = mocap_core::io::bvh::read_bvh(take)?;
+    let capture = simulate_capture(&motion, units_per_metre, options)?;
+    let simulation = &capture.simulation;
+    let files = write_simulation(output, simulation, &capture.body, options.seed, ntu)?;
+    Ok(SimulationReport {
+        sensors: simulation
+            .sensors
+            .iter()
+            .map(|s| SimulatedSensorReport {
+                id: s.id,
+                frames: s.frames.len(),
+                latency_seconds: s.latency,
+                drop_rate: s.drop_rate,
+            })
+            .collect(),
+        truth_frames: simulation.truth.frames.len(),
+        fps: simulation.truth.fps,
+        files,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -886,6 +821,6 @@ mod tests {
             !is_occluded(&pose, HIP_LEFT, front),
             "joints inside the torso capsule"
         );
-        assert!(facing(&pose).dot(Vec3::Z) > 0.9, "{}", facing(&pose));
+        assert!(facing_of(&pose).dot(Vec3::Z) > 0.9, "{}", facing_of(&pose));
     }
 }

@@ -1,30 +1,18 @@
 //! End-to-end checks on a real Bandai take: simulate sensors, calibrate from
 //! the body, fuse, compare with the truth.
 
-use std::path::PathBuf;
-
-use mocap_fuse::align::calibrate_from_body;
-use mocap_fuse::body::{BodyModel, MeasureOptions};
-use mocap_fuse::fusion::{Fuser, FusionOptions};
-use mocap_fuse::offline::{fuse_streams, SensorStreams};
-use mocap_fuse::sim::{center_truth, simulate, truth_from_motion, SimulationOptions};
-
-fn data() -> Option<PathBuf> {
-    let root = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let p = root.join("bandai/dataset-1/dataset-1_walk_normal_001.bvh");
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("note: {} not found; skipping", p.display());
-        None
-    }
-}
+use mocap_fuse::{
+    calibrate_from_body, center_truth, facing_of, fuse_streams, simulate, truth_from_motion,
+    BodyModel, Calibration, Fuser, FusionOptions, MeasureOptions, SensorStreams, SimulatedSensor,
+    SimulationOptions,
+};
 
 #[test]
 fn fusion_and_body_calibration_on_a_real_take() {
-    let Some(path) = data() else { return };
+    let Some(path) = mocap_testdata::shared("bandai/dataset-1/dataset-1_walk_normal_001.bvh")
+    else {
+        return;
+    };
     let motion = mocap_core::io::bvh::read_bvh(&path).unwrap();
     let mut truth = truth_from_motion(&motion, None).unwrap();
     center_truth(&mut truth, Some(2.0));
@@ -47,7 +35,7 @@ fn fusion_and_body_calibration_on_a_real_take() {
     let thigh = truth.frames[0][13].distance(truth.frames[0][12]);
     assert!((body.bone_lengths[13].unwrap() - thigh).abs() < 0.05);
 
-    let error = |options: FusionOptions, calibration: &mocap_fuse::calib::Calibration| {
+    let error = |options: FusionOptions, calibration: &Calibration| {
         let mut fuser = Fuser::new(options, body.clone());
         let fused = fuse_streams(&streams, calibration, &mut fuser, 30.0, Some(0.0));
         let mut sum = 0.0;
@@ -64,13 +52,13 @@ fn fusion_and_body_calibration_on_a_real_take() {
     assert!(best < 0.12, "{best}");
 
     // Calibration from the body: one of these sensors sees the person's
-    // back (left and right swapped), which used to give a solution turned by
-    // about 180 degrees. Now every sensor must come out within a few degrees
-    // (the bound is what the simulated per-joint biases allow: a body is a
+    // back (left and right swapped), which turns a fit of the labelled
+    // joints by about 180 degrees. Every sensor must come out within a few
+    // degrees (the bound is what the simulated per-joint biases allow: a body is a
     // thin vertical shape, and a few centimetres of bias turn the fit by
     // degrees about it), and fusion with it must stay close to fusion with
     // the true poses.
-    let behind = |s: &mocap_fuse::sim::SimulatedSensor| {
+    let behind = |s: &SimulatedSensor| {
         let cos = SimulationOptions::default()
             .model
             .behind_angle_degrees
@@ -81,7 +69,7 @@ fn fusion_and_body_calibration_on_a_real_take() {
             .filter(|f| {
                 let pose = truth.at(f.timestamp);
                 let to_sensor = (s.pose.translation - pose[0]).with_y(0.0).normalize();
-                mocap_fuse::sim::facing(&pose).dot(to_sensor) < cos
+                facing_of(&pose).dot(to_sensor) < cos
             })
             .count() as f32
             / s.frames.len() as f32

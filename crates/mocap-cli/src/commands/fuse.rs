@@ -1,32 +1,29 @@
 //! `mocap fuse`: multi-sensor skeleton capture (Kinect v2 style sensors).
-//! Argument parsing and calls into `mocap-fuse`; the work is there.
+//! Each subcommand parses its arguments and calls one function of
+//! `mocap-fuse`; the work is there.
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
-use mocap_fuse::align::{calibrate_from_body, calibrate_from_points, BodyCalibrationOptions};
-use mocap_fuse::body::{ranges_from_limits, BodyModel, MeasureOptions};
-use mocap_fuse::bvh::BvhOptions;
-use mocap_fuse::calib::{Calibration, RigidTransform, SensorPose};
-use mocap_fuse::eval::{CalibrationSource, EvalOptions};
-use mocap_fuse::fusion::{Fuser, FusionOptions, METHOD_NAMES};
-use mocap_fuse::net::{SendOptions, ServeOptions};
-use mocap_fuse::offline::SensorStreams;
-use mocap_fuse::output::FusedOutputs;
-use mocap_fuse::recording::{read_any_recording, SensorFrame};
+use mocap_fuse::{
+    BodyCalibrationOptions, BodyCalibrationReport, BoneLengthSource, CalibrationSource,
+    EvalOptions, Evaluation, FuseFilesOptions, FusionOptions, OutputFiles, OutputReport,
+    PerJointChart, ScanPair, SendOptions, ServeFilesOptions, SimulationOptions, METHOD_NAMES,
+};
 use serde::Serialize;
 
+use super::args::ReportArgs;
 use super::GlobalOptions;
 
 #[derive(clap::Args)]
 #[command(after_help = "A session, end to end:\n  \
-mocap fuse simulate take.bvh --sensors 3 --out sim/\n  \
-mocap fuse calibrate sim/sensor-*.jsonl --out rig.toml\n  \
-mocap fuse measure sim/sensor-*.jsonl --out body.json\n  \
-mocap fuse run sim/sensor-*.jsonl --calib rig.toml --body body.json --out fused.jsonl --out fused.bvh\n  \
-mocap fuse serve --calib rig.toml --body body.json --listen 127.0.0.1:9000 --out live.bvh &\n  \
+mocap fuse simulate take.bvh --sensors 3 -o sim/\n  \
+mocap fuse calibrate sim/sensor-*.jsonl -o rig.toml\n  \
+mocap fuse measure sim/sensor-*.jsonl -o body.json\n  \
+mocap fuse run sim/sensor-*.jsonl --calib rig.toml --body body.json -o fused.jsonl -o fused.bvh\n  \
+mocap fuse serve --calib rig.toml --body body.json --listen 127.0.0.1:9000 -o live.bvh &\n  \
 mocap fuse send sim/sensor-*.jsonl --to 127.0.0.1:9000 --realtime")]
 pub struct Args {
     #[command(subcommand)]
@@ -80,34 +77,34 @@ fn print_json(value: &impl Serialize) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn read_recordings(paths: &[PathBuf]) -> anyhow::Result<Vec<SensorFrame>> {
-    let mut frames = Vec::new();
-    for (i, path) in paths.iter().enumerate() {
-        frames.extend(read_any_recording(path, i as u16)?);
-    }
-    if frames.is_empty() {
-        bail!("the recordings hold no sensor frames");
-    }
-    Ok(frames)
+/// The BVH outputs' options of `run` and `serve`.
+#[derive(clap::Args)]
+struct FusedBvhArgs {
+    /// Length unit of the BVH output: cm, m or mm.
+    #[arg(long, default_value = "cm")]
+    bvh_units: String,
+    /// Bone lengths of the BVH skeleton: the median of the fused take, or the body file's.
+    #[arg(long, default_value = "fused", value_parser = ["fused", "body"])]
+    bvh_lengths: String,
 }
 
-fn parse_method(name: &str) -> anyhow::Result<FusionOptions> {
-    Ok(FusionOptions::preset(name)?)
-}
-
-fn bvh_units(text: &str) -> anyhow::Result<f32> {
-    match text {
-        "cm" => Ok(100.0),
-        "m" => Ok(1.0),
-        "mm" => Ok(1000.0),
-        other => bail!("--bvh-units {other:?}: expected cm, m or mm"),
-    }
-}
-
-fn bvh_lengths(text: &str) -> mocap_fuse::bvh::BoneLengthSource {
-    match text {
-        "body" => mocap_fuse::bvh::BoneLengthSource::Body,
-        _ => mocap_fuse::bvh::BoneLengthSource::Fused,
+impl FusedBvhArgs {
+    fn outputs(&self, paths: Vec<PathBuf>) -> anyhow::Result<OutputFiles> {
+        let bvh_units_per_metre = match self.bvh_units.as_str() {
+            "cm" => 100.0,
+            "m" => 1.0,
+            "mm" => 1000.0,
+            other => bail!("--bvh-units {other:?}: expected cm, m or mm"),
+        };
+        let bvh_lengths = match self.bvh_lengths.as_str() {
+            "body" => BoneLengthSource::Body,
+            _ => BoneLengthSource::Fused,
+        };
+        Ok(OutputFiles {
+            paths,
+            bvh_units_per_metre,
+            bvh_lengths,
+        })
     }
 }
 
@@ -119,7 +116,7 @@ struct SimulateArgs {
     bvh: PathBuf,
     /// Folder for the files (created if needed).
     #[arg(long, short)]
-    out: PathBuf,
+    output: PathBuf,
     /// Number of sensors, evenly spaced around the person.
     #[arg(long, default_value_t = 3)]
     sensors: usize,
@@ -137,55 +134,22 @@ struct SimulateArgs {
     json: bool,
 }
 
-#[derive(Serialize)]
-struct SimulateReport {
-    sensors: Vec<SimulatedSensorReport>,
-    truth_frames: usize,
-    fps: f64,
-    files: mocap_fuse::sim::SimulationFiles,
-}
-
-#[derive(Serialize)]
-struct SimulatedSensorReport {
-    id: u16,
-    frames: usize,
-    latency_seconds: f64,
-    drop_rate: f64,
-}
-
 fn simulate(args: SimulateArgs, _options: &GlobalOptions) -> anyhow::Result<()> {
-    use mocap_fuse::sim;
     if args.sensors == 0 {
         bail!("--sensors must be at least 1");
     }
-    let motion = mocap_core::io::bvh::read_bvh(&args.bvh)?;
-    let mut truth = sim::truth_from_motion(&motion, args.units_per_metre)?;
-    let sim_options = sim::SimulationOptions {
+    let simulation = SimulationOptions {
         sensors: args.sensors,
         seed: args.seed,
         ..Default::default()
     };
-    sim::center_truth(&mut truth, sim_options.treadmill_above);
-    let simulation = sim::simulate(&truth, &sim_options);
-    // The person, measured beforehand: from a second capture of the take
-    // (other sensor places and noise), as `mocap fuse measure` would.
-    let body = sim::measure_person(&truth, &sim_options);
-    let files = sim::write_simulation(&args.out, &simulation, &body, args.seed, args.ntu)?;
-    let report = SimulateReport {
-        sensors: simulation
-            .sensors
-            .iter()
-            .map(|s| SimulatedSensorReport {
-                id: s.id,
-                frames: s.frames.len(),
-                latency_seconds: s.latency,
-                drop_rate: s.drop_rate,
-            })
-            .collect(),
-        truth_frames: truth.frames.len(),
-        fps: truth.fps,
-        files,
-    };
+    let report = mocap_fuse::simulate_to_folder(
+        &args.bvh,
+        &args.output,
+        &simulation,
+        args.units_per_metre,
+        args.ntu,
+    )?;
     if args.json {
         return print_json(&report);
     }
@@ -195,7 +159,7 @@ fn simulate(args: SimulateArgs, _options: &GlobalOptions) -> anyhow::Result<()> 
         args.bvh.display(),
         report.truth_frames,
         report.fps,
-        args.out.display()
+        args.output.display()
     );
     for s in &report.sensors {
         println!(
@@ -216,9 +180,9 @@ fn simulate(args: SimulateArgs, _options: &GlobalOptions) -> anyhow::Result<()> 
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "From the body:   mocap fuse calibrate sensor-0.jsonl sensor-1.jsonl --out rig.toml\n\
-From room scans: mocap fuse calibrate --points sensor-0.ply sensor-1.ply --pairs pairs-0-1.txt --out rig.toml\n\
-With --points, an existing --out file is updated: the second scan's sensor is placed in the world of the first."
+    after_help = "From the body:   mocap fuse calibrate sensor-0.jsonl sensor-1.jsonl -o rig.toml\n\
+From room scans: mocap fuse calibrate --points sensor-0.ply sensor-1.ply --pairs pairs-0-1.txt -o rig.toml\n\
+With --points, an existing --output file is updated: the second scan's sensor is placed in the world of the first."
 )]
 struct CalibrateArgs {
     /// Recordings (.jsonl, NTU .skeleton) of every sensor watching the person at the same time.
@@ -226,7 +190,7 @@ struct CalibrateArgs {
     recordings: Vec<PathBuf>,
     /// The calibration file to write.
     #[arg(long, short)]
-    out: PathBuf,
+    output: PathBuf,
     /// The sensor whose camera frame is the world (body calibration; default: the lowest id).
     #[arg(long)]
     reference: Option<u16>,
@@ -247,18 +211,6 @@ struct CalibrateArgs {
     json: bool,
 }
 
-/// The sensor id in a file name: its last number (`sensor-2.ply` is 2).
-fn id_in_name(path: &Path) -> Option<u16> {
-    let stem = path.file_stem()?.to_str()?;
-    let digits: String = stem
-        .chars()
-        .rev()
-        .skip_while(|c| !c.is_ascii_digit())
-        .take_while(|c| c.is_ascii_digit())
-        .collect();
-    digits.chars().rev().collect::<String>().parse().ok()
-}
-
 fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     if let Some(points) = &args.points {
         return calibrate_points(&args, points, options);
@@ -266,36 +218,23 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
     if args.recordings.is_empty() {
         bail!("give the recordings of the sensors (body calibration) or --points A.ply B.ply");
     }
-    let frames = read_recordings(&args.recordings)?;
-    let streams = SensorStreams::new(frames);
-    let found = calibrate_from_body(
-        &streams,
+    let report = mocap_fuse::calibrate_recordings(
+        &args.recordings,
         &BodyCalibrationOptions {
             reference: args.reference,
             ..Default::default()
         },
+        &args.output,
     )?;
-    found.calibration.write(&args.out)?;
-    #[derive(Serialize)]
-    struct Report<'a> {
-        calibration: &'a Path,
-        reference: u16,
-        sensors: &'a [mocap_fuse::align::BodySensorReport],
-    }
-    let report = Report {
-        calibration: &args.out,
-        reference: found.reference,
-        sensors: &found.sensors,
-    };
     if args.json {
         return print_json(&report);
     }
     println!(
         "calibrated from the body; world = sensor {} -> {}",
-        found.reference,
-        args.out.display()
+        report.reference,
+        args.output.display()
     );
-    for s in &found.sensors {
+    for s in &report.sensors {
         println!(
             "  sensor {}: {} of {} joint pairs fit within 10 cm (RMS {:.1} mm), {} of {} frames with settled left/right, turn about the vertical known to about {:.1} degrees",
             s.sensor,
@@ -307,12 +246,11 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
             s.yaw_uncertainty_degrees
         );
     }
-    if found
-        .sensors
-        .iter()
-        .any(|s| s.yaw_uncertainty_degrees > 5.0)
-    {
-        println!("warning: the person moved too little for a sure calibration from the body (over 5 degrees of doubt); capture a take where they walk and turn, or refine with room scans (--points)");
+    if report.is_unsure() {
+        println!(
+            "warning: the person moved too little for a sure calibration from the body (over {} degrees of doubt); capture a take where they walk and turn, or refine with room scans (--points)",
+            BodyCalibrationReport::UNSURE_DEGREES
+        );
     }
     Ok(())
 }
@@ -322,76 +260,22 @@ fn calibrate_points(
     points: &[PathBuf],
     _options: &GlobalOptions,
 ) -> anyhow::Result<()> {
-    let [a_path, b_path] = points else {
+    let [a, b] = points else {
         bail!("--points takes two scans");
     };
-    let (a_id, b_id) = match &args.ids {
-        Some(ids) => (ids[0], ids[1]),
-        None => match (id_in_name(a_path), id_in_name(b_path)) {
-            (Some(a), Some(b)) => (a, b),
-            _ => bail!(
-                "cannot tell the sensor ids from the names {} and {}: give --ids A B",
-                a_path.display(),
-                b_path.display()
-            ),
-        },
+    let scans = ScanPair {
+        scans: [a.clone(), b.clone()],
+        pairs: args.pairs.clone(),
+        initial: args.initial.clone(),
+        ids: args.ids.as_deref().map(|ids| [ids[0], ids[1]]),
     };
-    if a_id == b_id {
-        bail!("both scans are of sensor {a_id}: give --ids A B");
+    let found = mocap_fuse::calibrate_scans(&scans, &args.output)?;
+    if found.from_identity {
+        eprintln!("note: no --pairs or --initial: ICP started from the identity, which works only for scans taken from nearly the same place");
     }
-    let a = mocap_fuse::ply::read_ply_points(a_path)?;
-    let b = mocap_fuse::ply::read_ply_points(b_path)?;
-    let pairs = match &args.pairs {
-        Some(p) => mocap_fuse::align::read_point_pairs(p)?,
-        None => Vec::new(),
-    };
-    let initial = match &args.initial {
-        Some(path) => {
-            let c = Calibration::read(path)?;
-            let (Some(wa), Some(wb)) = (c.get(a_id), c.get(b_id)) else {
-                bail!(
-                    "{}: --initial must hold both sensor {a_id} and sensor {b_id}",
-                    path.display()
-                );
-            };
-            Some(wa.inverse().then_after(wb))
-        }
-        None => None,
-    };
-    if pairs.is_empty() && initial.is_none() {
-        eprintln!("note: no --pairs or --initial: ICP starts from the identity, which works only for scans taken from nearly the same place");
-    }
-    let result = calibrate_from_points(&a, &b, &pairs, initial, &Default::default())?;
-    // Place B in the world of the output file (A's pose there, or A as the
-    // world when the file is new).
-    let mut calibration = if args.out.exists() {
-        Calibration::read(&args.out)?
-    } else {
-        Calibration::default()
-    };
-    let world_from_a = match calibration.get(a_id) {
-        Some(t) => *t,
-        None => {
-            calibration.set(SensorPose {
-                id: a_id,
-                transform: RigidTransform::IDENTITY,
-                method: Some("reference".into()),
-                rms_residual: None,
-                pairs: None,
-            });
-            RigidTransform::IDENTITY
-        }
-    };
-    calibration.set(SensorPose {
-        id: b_id,
-        transform: world_from_a.then_after(&result.transform),
-        method: Some("icp".into()),
-        rms_residual: Some(result.icp.rms),
-        pairs: Some(result.icp.pairs),
-    });
-    calibration.write(&args.out)?;
+    let result = &found.fit;
     if args.json {
-        return print_json(&result);
+        return print_json(result);
     }
     if let Some(fit) = &result.pairs_fit {
         println!(
@@ -401,7 +285,7 @@ fn calibrate_points(
         );
     }
     println!(
-        "ICP: {} point pairs, RMS {:.1} mm, {} iterations{} -> sensor {b_id} in {}",
+        "ICP: {} point pairs, RMS {:.1} mm, {} iterations{} -> sensor {} in {}",
         result.icp.pairs,
         result.icp.rms * 1000.0,
         result.icp.iterations,
@@ -410,7 +294,8 @@ fn calibrate_points(
         } else {
             " (not converged)"
         },
-        args.out.display()
+        found.ids[1],
+        args.output.display()
     );
     if !result.icp.unconstrained.is_empty() {
         println!(
@@ -430,7 +315,7 @@ struct MeasureArgs {
     recordings: Vec<PathBuf>,
     /// The body file to write (JSON).
     #[arg(long, short)]
-    out: PathBuf,
+    output: PathBuf,
     /// Take the joint ranges from the limits of an ASF skeleton instead of measuring them.
     #[arg(long, value_name = "SKELETON.asf")]
     limits: Option<PathBuf>,
@@ -440,27 +325,21 @@ struct MeasureArgs {
 }
 
 fn measure(args: MeasureArgs, _options: &GlobalOptions) -> anyhow::Result<()> {
-    let frames = read_recordings(&args.recordings)?;
-    let mut body = BodyModel::measure(frames.iter().map(|f| &f.joints), MeasureOptions::default());
-    if let Some(asf) = &args.limits {
-        let skeleton = mocap_core::io::asf_amc::read_asf(asf)?
-            .to_skeleton(mocap_core::io::asf_amc::LengthUnit::Centimetres)?;
-        body.ranges = ranges_from_limits(&skeleton)?;
-    }
-    body.write(&args.out)?;
+    let body =
+        mocap_fuse::measure_recordings(&args.recordings, args.limits.as_deref(), &args.output)?;
     if args.json {
         return print_json(&body);
     }
-    let measured = body.bone_lengths.iter().flatten().count();
-    let ranges = body.ranges.iter().flatten().count();
     println!(
-        "{measured} bone lengths and {ranges} joint ranges{} -> {}",
+        "{} bone lengths and {} joint ranges{} -> {}",
+        body.bone_lengths.iter().flatten().count(),
+        body.ranges.iter().flatten().count(),
         if args.limits.is_some() {
             " (from the ASF limits)"
         } else {
             ""
         },
-        args.out.display()
+        args.output.display()
     );
     Ok(())
 }
@@ -480,41 +359,21 @@ struct RunArgs {
     body: Option<PathBuf>,
     /// Output: .jsonl (fused joints) or .bvh (a motion on a fitted skeleton); repeat for both.
     #[arg(long, short, required = true)]
-    out: Vec<PathBuf>,
+    output: Vec<PathBuf>,
     /// Fusion method.
     #[arg(long, default_value = "best", value_parser = clap::builder::PossibleValuesParser::new(METHOD_NAMES))]
     method: String,
     /// Fused frames per second.
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
-    /// Length unit of the BVH output: cm, m or mm.
-    #[arg(long, default_value = "cm")]
-    bvh_units: String,
-    /// Bone lengths of the BVH skeleton: the median of the fused take, or the body file's.
-    #[arg(long, default_value = "fused", value_parser = ["fused", "body"])]
-    bvh_lengths: String,
+    #[command(flatten)]
+    bvh: FusedBvhArgs,
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
 }
 
-#[derive(Serialize)]
-struct RunReport {
-    fused_frames: usize,
-    sensors: Vec<u16>,
-    body_measured_from_recordings: bool,
-    outputs: Vec<mocap_fuse::output::OutputReport>,
-}
-
-/// The body from its file, or measured from the recordings.
-fn body_of(path: Option<&Path>, frames: &[SensorFrame]) -> anyhow::Result<BodyModel> {
-    Ok(match path {
-        Some(p) => BodyModel::read(p)?,
-        None => BodyModel::measure(frames.iter().map(|f| &f.joints), MeasureOptions::default()),
-    })
-}
-
-fn print_outputs(outputs: &[mocap_fuse::output::OutputReport]) {
+fn print_outputs(outputs: &[OutputReport]) {
     for o in outputs {
         match &o.fit_error {
             Some(e) => println!(
@@ -532,36 +391,19 @@ fn print_outputs(outputs: &[mocap_fuse::output::OutputReport]) {
 }
 
 fn run_offline(args: RunArgs, options: &GlobalOptions) -> anyhow::Result<()> {
-    let calibration = Calibration::read(&args.calib)?;
-    let fusion = parse_method(&args.method)?;
-    let frames = read_recordings(&args.recordings)?;
-    let mut sensors: Vec<u16> = frames.iter().map(|f| f.sensor).collect();
-    sensors.sort();
-    sensors.dedup();
-    let body = body_of(args.body.as_deref(), &frames)?;
+    let fusion = FusionOptions::preset(&args.method)?;
+    let outputs = args.bvh.outputs(args.output.clone())?;
     if args.body.is_none() && !options.quiet {
         eprintln!("note: no --body: the person's bone lengths and ranges are measured from these recordings");
     }
-    let bvh = BvhOptions {
-        units_per_metre: bvh_units(&args.bvh_units)?,
+    let report = mocap_fuse::fuse_files(&FuseFilesOptions {
+        recordings: args.recordings,
+        calibration: args.calib,
+        body: args.body,
+        outputs,
+        fusion,
         fps: args.fps,
-    };
-    let mut outputs = FusedOutputs::create(&args.out, body.clone(), bvh)?
-        .with_bone_lengths(bvh_lengths(&args.bvh_lengths));
-    let mut fuser = Fuser::new(fusion, body);
-    let count = mocap_fuse::offline::fuse_recordings(
-        frames,
-        &calibration,
-        &mut fuser,
-        args.fps,
-        &mut outputs,
-    )?;
-    let report = RunReport {
-        fused_frames: count,
-        sensors,
-        body_measured_from_recordings: args.body.is_none(),
-        outputs: outputs.reports().to_vec(),
-    };
+    })?;
     if args.json {
         return print_json(&report);
     }
@@ -588,7 +430,7 @@ struct ServeArgs {
     listen: SocketAddr,
     /// Output: .jsonl (written as frames come) or .bvh (written at the end); repeat for both.
     #[arg(long, short, required = true)]
-    out: Vec<PathBuf>,
+    output: Vec<PathBuf>,
     /// Fused frames per second.
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
@@ -607,12 +449,8 @@ struct ServeArgs {
     /// Stop when no datagram has come for this many seconds after the first.
     #[arg(long)]
     idle_exit: Option<f64>,
-    /// Length unit of the BVH output: cm, m or mm.
-    #[arg(long, default_value = "cm")]
-    bvh_units: String,
-    /// Bone lengths of the BVH skeleton: the median of the fused take, or the body file's.
-    #[arg(long, default_value = "fused", value_parser = ["fused", "body"])]
-    bvh_lengths: String,
+    #[command(flatten)]
+    bvh: FusedBvhArgs,
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
@@ -628,22 +466,15 @@ fn seconds(name: &str, value: Option<f64>) -> anyhow::Result<Option<Duration>> {
 }
 
 fn serve(args: ServeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
-    let calibration = Calibration::read(&args.calib)?;
-    let body = BodyModel::read(&args.body)?;
     if !(args.fps.is_finite() && args.fps > 0.0) {
         bail!("--fps must be positive");
     }
-    let bvh = BvhOptions {
-        units_per_metre: bvh_units(&args.bvh_units)?,
-        fps: args.fps,
-    };
-    let mut outputs = FusedOutputs::create(&args.out, body.clone(), bvh)?
-        .with_bone_lengths(bvh_lengths(&args.bvh_lengths));
-    let serve_options = ServeOptions {
+    let serve_options = ServeFilesOptions {
+        calibration: args.calib,
+        body: args.body,
+        outputs: args.bvh.outputs(args.output)?,
         listen: args.listen,
-        calibration,
-        body,
-        fusion: parse_method(&args.method)?,
+        fusion: FusionOptions::preset(&args.method)?,
         fps: args.fps,
         wait: args.wait,
         sensor_timeout: args.sensor_timeout,
@@ -651,20 +482,11 @@ fn serve(args: ServeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         idle_exit: seconds("idle-exit", args.idle_exit)?,
     };
     let quiet = options.quiet;
-    let report = mocap_fuse::net::serve_blocking_with(serve_options, &mut outputs, |addr| {
+    let report = mocap_fuse::serve_files(serve_options, |addr| {
         if !quiet {
             eprintln!("fuse serve: listening on {addr} (Ctrl-C to stop)");
         }
     })?;
-    #[derive(Serialize)]
-    struct Report {
-        server: mocap_fuse::net::ServeReport,
-        outputs: Vec<mocap_fuse::output::OutputReport>,
-    }
-    let report = Report {
-        server: report,
-        outputs: outputs.reports().to_vec(),
-    };
     if args.json {
         return print_json(&report);
     }
@@ -706,9 +528,8 @@ fn send(args: SendArgs, _options: &GlobalOptions) -> anyhow::Result<()> {
     if !(args.speed.is_finite() && args.speed > 0.0) {
         bail!("--speed must be positive");
     }
-    let frames = read_recordings(&args.recordings)?;
-    let report = mocap_fuse::net::send_blocking(
-        &frames,
+    let report = mocap_fuse::send_files(
+        &args.recordings,
         SendOptions {
             to: args.to,
             realtime: args.realtime,
@@ -749,141 +570,72 @@ struct EvalArgs {
     /// Also run methods with joint ranges from this ASF skeleton's limits (BVH).
     #[arg(long, value_name = "SKELETON.asf")]
     limits: Option<PathBuf>,
-    /// Write the results as JSON here (`-`: standard output).
-    #[arg(long)]
-    json: Option<PathBuf>,
-    /// Write the results as a Markdown table here.
-    #[arg(long)]
-    md: Option<PathBuf>,
     /// Draw per-joint position errors (BVH) here: `per-joint-<K>-sensors.png` and `.svg`.
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
-    let is_recording = |p: &PathBuf| {
-        p.extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("skeleton") || e.eq_ignore_ascii_case("jsonl"))
-    };
-    let recordings = args.inputs.iter().filter(|p| is_recording(p)).count();
     let command = format!(
         "mocap fuse eval {}",
         std::env::args().skip(3).collect::<Vec<_>>().join(" ")
     );
-    let (markdown, json) = if recordings == args.inputs.len() {
-        let takes = mocap_fuse::eval::group_takes(&args.inputs);
-        let methods: Vec<(String, FusionOptions)> = ["state", "report", "best"]
-            .iter()
-            .map(|m| Ok((format!("fused ({m})"), FusionOptions::preset(m)?)))
-            .collect::<anyhow::Result<_>>()?;
-        let progress = options.progress(takes.len(), "evaluating");
-        let mut reports = Vec::new();
-        for (take, files) in &takes {
-            let frames = read_recordings(files)?;
-            reports.push(mocap_fuse::eval::evaluate_consistency(
-                take, frames, &methods, 30.0,
-            )?);
-            progress.inc(1);
-        }
-        progress.finish_and_clear();
-        (
-            mocap_fuse::eval::consistency_markdown(&reports, &command),
-            serde_json::to_string_pretty(&reports)?,
-        )
-    } else if recordings == 0 {
-        let limit_ranges = match &args.limits {
-            Some(asf) => Some(ranges_from_limits(
-                &mocap_core::io::asf_amc::read_asf(asf)?
-                    .to_skeleton(mocap_core::io::asf_amc::LengthUnit::Centimetres)?,
-            )?),
-            None => None,
-        };
-        let eval_options = EvalOptions {
-            inputs: args.inputs.clone(),
-            sensor_counts: args.sensors.clone(),
-            seeds: args.seeds.clone(),
-            calibration: if args.calib == "body" {
-                CalibrationSource::Body
-            } else {
-                CalibrationSource::Truth
-            },
-            limit_ranges,
-            ..Default::default()
-        };
-        let files = mocap_fuse::eval::collect_bvh_files(&args.inputs)?;
-        let progress = options.progress(files.len(), "evaluating");
-        let report = mocap_fuse::eval::evaluate_with(&eval_options, &mut |done, _| {
-            progress.set_position(done as u64)
-        })?;
-        progress.finish_and_clear();
-        if let Some(dir) = &args.plots {
-            plot_per_joint_errors(&report, dir)?;
-        }
-        (
-            mocap_fuse::eval::report_markdown(&report, &command),
-            serde_json::to_string_pretty(&report)?,
-        )
-    } else {
-        bail!("give either BVH takes (simulated sensors, ground truth) or recordings (.skeleton, .jsonl), not both");
+    let eval_options = EvalOptions {
+        inputs: args.inputs,
+        sensor_counts: args.sensors,
+        seeds: args.seeds,
+        calibration: if args.calib == "body" {
+            CalibrationSource::Body
+        } else {
+            CalibrationSource::Truth
+        },
+        limits: args.limits,
+        ..Default::default()
     };
-    match args.json.as_deref() {
-        Some(p) if p == Path::new("-") => println!("{json}"),
-        Some(p) => mocap_core::io::atomic::write_bytes_atomically(p, json.as_bytes())?,
-        None => {}
+    let progress = options.progress(0, "evaluating");
+    let evaluation = mocap_fuse::evaluate_inputs(&eval_options, &mut |done, total| {
+        progress.set_length(total as u64);
+        progress.set_position(done as u64);
+    })?;
+    progress.finish_and_clear();
+    if let (Some(dir), Evaluation::Truth(report)) = (&args.plots, &evaluation) {
+        draw_per_joint_charts(&report.per_joint_charts(), dir)?;
     }
-    if let Some(p) = &args.md {
-        mocap_core::io::atomic::write_bytes_atomically(p, markdown.as_bytes())?;
+    let markdown = evaluation.markdown(&command);
+    if let Some(path) = &args.report.markdown {
+        mocap_core::io::atomic::write_bytes_atomically(path, markdown.as_bytes())?;
     }
-    if args.json.as_deref() != Some(Path::new("-")) {
+    if args.report.json {
+        print_json(&evaluation)
+    } else {
         println!("{markdown}");
+        Ok(())
     }
-    Ok(())
 }
 
-/// Per sensor count, grouped bars of each joint's mean position error for
-/// the best single sensor, the report's baseline and method, and our best
-/// version, with the standard deviation over runs as error bars.
-fn plot_per_joint_errors(report: &mocap_fuse::eval::EvalReport, dir: &Path) -> anyhow::Result<()> {
+/// Draws each chart as `per-joint-<K>-sensors.png` and `.svg` in `dir`.
+fn draw_per_joint_charts(charts: &[PerJointChart], dir: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let shown = |name: &str| {
-        name == "best single sensor"
-            || name.starts_with("state only (")
-            || name.contains("(report method)")
-            || name.starts_with("best:")
-    };
-    let joints: Vec<String> = mocap_core::bodymap::KINECT_V2_JOINTS
-        .iter()
-        .map(|(name, _)| name.to_string())
-        .collect();
-    let mut counts: Vec<usize> = report.results.iter().map(|r| r.sensors).collect();
-    counts.dedup();
-    for k in counts {
-        let series: Vec<mocap_view::BarSeries> = report
-            .results
-            .iter()
-            .filter(|r| r.sensors == k && shown(&r.method) && r.per_joint_mm.len() == joints.len())
-            .map(|r| mocap_view::BarSeries {
-                label: format!("{} ({:.1} mm)", r.method, r.mpjpe_mm),
-                values: r.per_joint_mm.iter().map(|&v| v as f32).collect(),
-                errors: Some(r.per_joint_sd_mm.iter().map(|&v| v as f32).collect()),
-            })
-            .collect();
-        if series.is_empty() {
-            continue;
-        }
+    for chart in charts {
         let plot = mocap_view::BarPlot {
-            title: format!(
-                "position error per joint, {k} sensors ({} takes x {} seeds; bars: sd over runs)",
-                report.clips.len(),
-                report.seeds.len()
-            ),
+            title: chart.title.clone(),
             y_label: "mm".into(),
-            categories: joints.clone(),
-            series,
+            categories: chart.joints.clone(),
+            series: chart
+                .series
+                .iter()
+                .map(|s| mocap_view::BarSeries {
+                    label: s.label.clone(),
+                    values: s.values.clone(),
+                    errors: Some(s.errors.clone()),
+                })
+                .collect(),
             size: (1600, 600),
         };
         for extension in ["png", "svg"] {
-            let path = dir.join(format!("per-joint-{k}-sensors.{extension}"));
+            let path = dir.join(format!("per-joint-{}-sensors.{extension}", chart.sensors));
             mocap_view::plot_bars(&path, &plot)
                 .with_context(|| format!("drawing {}", path.display()))?;
         }
