@@ -133,7 +133,10 @@ mod tests {
         }
         let mut shared = Vec::new();
         for group in command.get_groups() {
-            if let Some(i) = SHARED_GROUPS.iter().position(|g| *g == group.get_id().as_str()) {
+            if let Some(i) = SHARED_GROUPS
+                .iter()
+                .position(|g| *g == group.get_id().as_str())
+            {
                 uses[i] += 1;
                 shared.extend(group.get_args().map(|id| id.as_str().to_string()));
             }
@@ -163,7 +166,9 @@ mod tests {
                 breaches.push(format!("{path}: --markdown takes no FILE"));
             }
             if long == "device" && !is_shared {
-                breaches.push(format!("{path}: --device outside commands::args::DeviceArgs"));
+                breaches.push(format!(
+                    "{path}: --device outside commands::args::DeviceArgs"
+                ));
             }
         }
         if own > MAX_OWN_OPTIONS {

@@ -26,7 +26,8 @@ use mocap_search::features::motion_features;
 use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
 use mocap_style::convert::{windowed_mean, Asymmetry, ConvertOptions};
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-use mocap_style::eval::{gait_period, sideways_ankle_values};
+use mocap_style::eval::sideways_ankle_values;
+use mocap_style::features::gait_period;
 use mocap_style::features::RigLayout;
 
 /// (slow, swing) standard deviations of the left and right ankles' sideways

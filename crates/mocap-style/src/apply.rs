@@ -45,8 +45,7 @@ use crate::convert::{
     Method, RootPath, StyleInput,
 };
 use crate::data::mirrored;
-use crate::eval::gait_period;
-use crate::features::{compose, decompose, sample_frames, RootTrack};
+use crate::features::{compose, decompose, gait_period, sample_frames, RootTrack};
 use crate::train::StyleModel;
 use crate::{invalid, Result};
 

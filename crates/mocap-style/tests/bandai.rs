@@ -11,9 +11,9 @@ use mocap_nn::device::DeviceChoice;
 use mocap_style::apply::{apply, prepare_style, restyle, ApplyOptions, StageTimings};
 use mocap_style::convert::{ConvertOptions, Method};
 use mocap_style::eval::{
-    feet_sideways_offset, foot_skating, gait_period, largest_foot_reach, planted_foot_sliding,
+    feet_sideways_offset, foot_skating, largest_foot_reach, planted_foot_sliding,
 };
-use mocap_style::features::RigLayout;
+use mocap_style::features::{gait_period, RigLayout};
 use mocap_style::train::StyleModel;
 
 fn bandai(set: &str, name: &str) -> Option<PathBuf> {
