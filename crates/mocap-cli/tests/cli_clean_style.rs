@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use mocap_core::io::bvh::read_bvh;
-use mocap_style::eval::{foot_skating, planted_foot_sliding};
-use mocap_style::features::RigLayout;
+use mocap_style::{foot_skating, planted_foot_sliding, RigLayout};
 
 fn mocap(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mocap"))

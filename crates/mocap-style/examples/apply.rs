@@ -8,8 +8,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::Method;
+use mocap_style::{apply, parse_blend, ApplyOptions, Method};
 
 fn main() {
     let mut options = ApplyOptions::new("", "", "out.bvh");

@@ -32,14 +32,11 @@ use std::path::PathBuf;
 use mocap_core::ops::trim;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{
-    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings,
+use mocap_style::{
+    feet_sideways_offset, held_out, labelled_paths, list_bvh, load_clips, load_model,
+    prepare_source, prepare_style, restyle_prepared, train_classifiers, Asymmetry, Clip,
+    ClipFilter, ConvertOptions, EvalOptions, HeldOutTake, StageTimings,
 };
-use mocap_style::convert::{Asymmetry, ConvertOptions};
-use mocap_style::data::{
-    held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake,
-};
-use mocap_style::eval::{feet_sideways_offset, train_classifiers, EvalOptions};
 
 fn feet_offset(motion: &Motion) -> f64 {
     feet_sideways_offset(motion).expect("pose values")

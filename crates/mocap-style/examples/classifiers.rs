@@ -12,7 +12,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::eval::{check_classifiers, CrossValidate, EvalOptions};
+use mocap_style::{check_classifiers, CrossValidate, EvalOptions};
 
 fn main() {
     let mut options = EvalOptions::default();

@@ -29,16 +29,12 @@ use std::path::PathBuf;
 
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{
-    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings,
+use mocap_style::{
+    clean_foot_contacts, held_out, labelled_paths, largest_foot_reach, list_bvh, load_clips,
+    load_model, planted_foot_sliding, prepare_source, prepare_style, restyle_prepared, travelled,
+    ClipFilter, ContactOptions, ConvertOptions, HeldOutTake, MotionMeasures, RigLayout,
+    StageTimings, WALKING_CONTENTS,
 };
-use mocap_style::contact::{clean_foot_contacts, travelled, ContactOptions};
-use mocap_style::convert::ConvertOptions;
-use mocap_style::data::{
-    held_out, labelled_paths, list_bvh, load_clips, ClipFilter, HeldOutTake, WALKING_CONTENTS,
-};
-use mocap_style::eval::{largest_foot_reach, planted_foot_sliding, MotionMeasures};
-use mocap_style::features::RigLayout;
 
 const SOURCES: [&str; 3] = ["walk", "walk-turn-left", "walk-turn-right"];
 

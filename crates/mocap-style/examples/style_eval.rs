@@ -9,8 +9,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::convert::RootPath;
-use mocap_style::eval::{evaluate, EvalOptions};
+use mocap_style::{evaluate, EvalOptions, RootPath};
 
 fn main() {
     let mut options = EvalOptions::default();

@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{train, TrainOptions};
 
 fn main() {
     let mut options = TrainOptions::default();

@@ -23,12 +23,11 @@ use mocap_core::io::read_motion;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
 use mocap_search::features::motion_features;
-use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
-use mocap_style::convert::{windowed_mean, Asymmetry, ConvertOptions};
-use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-use mocap_style::eval::sideways_ankle_values;
-use mocap_style::features::gait_period;
-use mocap_style::features::RigLayout;
+use mocap_style::{
+    gait_period, labelled_paths, list_bvh, load_model, prepare_style, restyle,
+    sideways_ankle_values, windowed_mean, Asymmetry, ClipFilter, ConvertOptions, RigLayout,
+    StageTimings,
+};
 
 /// (slow, swing) standard deviations of the left and right ankles' sideways
 /// offsets; `None` for a clip without a gait.

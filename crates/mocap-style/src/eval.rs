@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 use crate::apply::{
     load_model, prepare_source, prepare_style, restyle_prepared, StageTimings, StyleClip,
 };
-pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
+use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
 use crate::contact::{flat_foot_steps, heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};

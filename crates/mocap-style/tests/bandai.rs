@@ -8,13 +8,11 @@ use std::path::PathBuf;
 use mocap_core::forward_kinematics;
 use mocap_core::io::bvh::read_bvh;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{apply, prepare_style, restyle, ApplyOptions, StageTimings};
-use mocap_style::convert::{ConvertOptions, Method};
-use mocap_style::eval::{
-    feet_sideways_offset, foot_skating, largest_foot_reach, planted_foot_sliding,
+use mocap_style::{
+    apply, feet_sideways_offset, foot_skating, gait_period, largest_foot_reach,
+    planted_foot_sliding, prepare_style, restyle, ApplyOptions, ConvertOptions, Method, RigLayout,
+    StageTimings, StyleModel,
 };
-use mocap_style::features::{gait_period, RigLayout};
-use mocap_style::train::StyleModel;
 
 fn bandai(set: &str, name: &str) -> Option<PathBuf> {
     let dir = std::env::var_os("MOCAP_SHARED_DATA")
@@ -33,7 +31,7 @@ fn bandai(set: &str, name: &str) -> Option<PathBuf> {
 struct Pair {
     model: StyleModel,
     source: mocap_core::Motion,
-    clip: mocap_style::apply::StyleClip,
+    clip: mocap_style::StyleClip,
     timings: StageTimings,
     rig: RigLayout,
 }
@@ -338,12 +336,13 @@ fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
 /// and with the forest's votes added (`--style-judge both`).
 #[test]
 fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
-    use mocap_style::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
-    use mocap_style::classify_net::NetConfig;
-    use mocap_style::data::{labelled_paths, load_clips, ClipFilter};
+    use mocap_style::{
+        labelled_paths, load_clips, ClassifierConfig, ClassifierModel, ClipClassifier, ClipFilter,
+        Descriptor, NetConfig, Windows,
+    };
 
     let styles = ["active", "elderly", "exhausted"];
-    let load = |takes: &[&str]| -> Option<Vec<mocap_style::data::Clip>> {
+    let load = |takes: &[&str]| -> Option<Vec<mocap_style::Clip>> {
         let mut paths = Vec::new();
         for style in styles {
             for take in takes {
@@ -380,8 +379,8 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     };
     // The conv net alone, and with the forest's votes added (the forest is
     // trained on the clips as they are, the net on their mirrors too).
-    let net = judge(Model::ConvNet, true);
-    let both = judge(Model::ForestAndConvNet, true);
+    let net = judge(ClassifierModel::ConvNet, true);
+    let both = judge(ClassifierModel::ForestAndConvNet, true);
     for judge in [&net, &both] {
         assert_eq!(judge.classes(), styles);
         let mut wrong = Vec::new();
@@ -395,7 +394,7 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     }
     // The votes of both are the forest's (on the clips as they are) plus
     // the net's, same seeds.
-    let forest = judge(Model::Forest, false);
+    let forest = judge(ClassifierModel::Forest, false);
     for clip in &test {
         let (f, n, b) = (
             forest.votes(&clip.motion).unwrap(),
@@ -410,7 +409,7 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
 
 /// The shipped model and the held-out dataset-2 active walk, prepared as
 /// the style clip of the turn tests; `None` without the data.
-fn model_and_active_walk() -> Option<(StyleModel, mocap_style::apply::StyleClip)> {
+fn model_and_active_walk() -> Option<(StyleModel, mocap_style::StyleClip)> {
     let path = bandai("dataset-2", "dataset-2_walk_active_031.bvh")?;
     let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
     let mut t = StageTimings::default();
@@ -421,10 +420,10 @@ fn model_and_active_walk() -> Option<(StyleModel, mocap_style::apply::StyleClip)
 /// `source` restyled with `clip` by the default settings but `asymmetry`.
 fn restyled_with(
     model: &StyleModel,
-    clip: &mocap_style::apply::StyleClip,
+    clip: &mocap_style::StyleClip,
     source: &mocap_core::Motion,
-    asymmetry: mocap_style::convert::Asymmetry,
-) -> mocap_style::apply::Restyled {
+    asymmetry: mocap_style::Asymmetry,
+) -> mocap_style::Restyled {
     let options = ConvertOptions {
         asymmetry,
         ..ConvertOptions::default()
@@ -452,7 +451,7 @@ fn restyled_with(
 /// at most a quarter.
 #[test]
 fn restyled_turns_keep_their_sideways_footwork() {
-    use mocap_style::convert::Asymmetry;
+    use mocap_style::Asymmetry;
 
     let feet_offset = |motion: &mocap_core::Motion| feet_sideways_offset(motion).unwrap();
     let Some((model, clip)) = model_and_active_walk() else {
@@ -515,7 +514,7 @@ fn restyled_turns_keep_their_sideways_footwork() {
 #[test]
 fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
     use mocap_core::ops::trim;
-    use mocap_style::convert::Asymmetry;
+    use mocap_style::Asymmetry;
 
     let Some((model, clip)) = model_and_active_walk() else {
         return;
@@ -587,7 +586,7 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
 /// takes'.
 #[test]
 fn the_autoencoder_keeps_a_flat_foot_nearly_still() {
-    use mocap_style::data::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter};
+    use mocap_style::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter};
 
     let Some(active_walk) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
         return;

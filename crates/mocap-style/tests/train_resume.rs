@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{train, TrainOptions};
 
 #[test]
 fn a_resumed_run_matches_an_uninterrupted_one() {

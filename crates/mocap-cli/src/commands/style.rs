@@ -5,11 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::{Asymmetry, Method, RootPath};
-use mocap_style::data::HeldOutTake;
-use mocap_style::eval::{evaluate, EvalOptions, StyleJudge};
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{
+    apply, evaluate, parse_blend, train, ApplyOptions, Asymmetry, EvalOptions, HeldOutTake, Method,
+    RootPath, StyleJudge, TrainOptions,
+};
 
 use super::{write_output, GlobalOptions};
 
