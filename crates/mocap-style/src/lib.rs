@@ -135,8 +135,6 @@ pub use classify::{
     Windows,
 };
 pub use classify_net::NetConfig;
-#[doc(hidden)]
-pub use eval::{check_classifiers, sideways_ankle_values, ClassifierCheck, CrossValidate};
 pub use eval::{
     evaluate, feet_sideways_offset, foot_skating, largest_foot_reach, planted_foot_sliding,
     train_classifiers, EvalOptions, EvalReport, MethodScores, MotionMeasures, PairResult,

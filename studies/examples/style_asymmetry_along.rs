@@ -1,12 +1,12 @@
 //! Takes that walk straight and then turn (or turn and then walk straight),
 //! restyled with the source's left-right asymmetry kept along time (the
 //! default, `--asymmetry source`), kept as one offset for the whole clip
-//! (`source-clip`, session 16) and not kept (`style`, the report's method):
+//! (`source-clip`) and not kept (`style`, the report's method):
 //! does each part keep its own footwork? (bench/results/style.md, "Turns
 //! kept along the take").
 //!
 //! ```text
-//! cargo run -p mocap-style --example asymmetry_along -- DIR \
+//! cargo run --release -p mocap-studies --example style_asymmetry_along -- DIR \
 //!     [--held-out last|first] [--model M]
 //! ```
 //!
@@ -81,7 +81,7 @@ fn main() {
         .unwrap_or_default();
     let model_path = option("--model").map(PathBuf::from);
     let [dir] = args.as_slice() else {
-        eprintln!("usage: asymmetry_along DIR [--held-out last|first] [--model M]");
+        eprintln!("usage: style_asymmetry_along DIR [--held-out last|first] [--model M]");
         std::process::exit(2);
     };
     let files = labelled_paths(

@@ -4,7 +4,7 @@
 //! "The other fold").
 //!
 //! ```text
-//! cargo run -p mocap-style --example feature_contrast -- \
+//! cargo run --release -p mocap-studies --example style_feature_contrast -- \
 //!     DIR CONTENT_A CONTENT_B FILE... [--top 12]
 //! ```
 //!
@@ -48,7 +48,7 @@ fn main() {
         args.drain(i..i + 2);
     }
     let [dir, a, b, files @ ..] = args.as_slice() else {
-        eprintln!("usage: feature_contrast DIR CONTENT_A CONTENT_B FILE... [--top N]");
+        eprintln!("usage: style_feature_contrast DIR CONTENT_A CONTENT_B FILE... [--top N]");
         std::process::exit(2);
     };
     let labelled = labelled_paths(

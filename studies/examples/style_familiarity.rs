@@ -3,7 +3,7 @@
 //! the measurement behind [`mocap_style::UNFAMILIAR_SOURCE_DEG`].
 //!
 //! ```text
-//! cargo run -p mocap-style --example familiarity -- [--model M.safetensors] \
+//! cargo run --release -p mocap-studies --example style_familiarity -- [--model M.safetensors] \
 //!     [--trained-on walk,walk-back,...] DIR...
 //! ```
 //!
