@@ -505,7 +505,7 @@ fn style_apply_restyles_the_bundled_walk() {
     // distance the source covers.
     let (path_report, path_motion) = restyle(&["--root", "source"]);
     let (along_report, along_motion) = restyle(&[]);
-    let (feet_report, feet_motion) = restyle(&["--root-from-feet"]);
+    let (feet_report, feet_motion) = restyle(&["--root", "feet"]);
     assert_eq!(path_report["root"], "source");
     assert_eq!(along_report["root"], "feet-along-source");
     assert_eq!(feet_report["root"], "feet");
