@@ -17,8 +17,8 @@
 //!    48`, a source stride that matches the style best when shrunk to 36
 //!    frames comes out 48 frames long, at the style's pace. Fixed patches
 //!    always take `L = P`. (The report does not give `P`; 48 was chosen on
-//!    one fold of the Bandai takes and judged on the other, 32 before
-//!    session 24: bench/results/style.md, "The patch length, again".)
+//!    one fold of the Bandai takes and judged on the other:
+//!    bench/results/style.md, "The patch length, again".)
 //! 3. Seams: a second series of patches, offset by half a patch (each from
 //!    the centre of one stretched patch to the centre of the next), is
 //!    matched too, and the two are blended with linear weights along time
@@ -49,7 +49,7 @@
 //!    a turn keeps the side its feet are placed to. Averaged over two
 //!    strides rather than the whole clip, a take that walks straight and
 //!    then turns keeps each part's own offset; [`Asymmetry::SourceClip`]
-//!    keeps one offset for the whole clip (session 16), and
+//!    keeps one offset for the whole clip, and
 //!    [`Asymmetry::Style`] leaves it out (the report's method).
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
@@ -194,7 +194,7 @@ pub enum Asymmetry {
     /// offset for the whole clip ([`Asymmetry::SourceClip`]).
     #[default]
     Source,
-    /// The source's, one offset for the whole clip (session 16): the
+    /// The source's, one offset for the whole clip: the
     /// half-difference of the mean latent codes of the source and its
     /// mirror.
     SourceClip,
@@ -355,7 +355,7 @@ impl ConvertOptions {
             return Err(invalid(format!(
                 "elastic patches stretch a patch by up to {:.0}% in steps of {} frames, so a \
                  patch of {} frames cannot stretch: use a patch of {} frames or more, or fixed \
-                 patches (--no-elastic)",
+                 patches (--method fixed-patches)",
                 self.stretch * 100.0,
                 self.stretch_step,
                 self.patch,

@@ -119,7 +119,7 @@ pub enum StyleJudge {
     /// The small conv net on per-frame values and their changes, trained on
     /// the clips and their mirror images (a second opinion).
     ConvNet,
-    /// Both, their votes added with equal weight (session 20).
+    /// Both, their votes added with equal weight.
     Both,
 }
 

@@ -1,7 +1,7 @@
 //! Style transfer with the shipped default model on Bandai Namco takes.
 //!
-//! The data is found at `<workspace>/../shared/data` or `$MOCAP_SHARED_DATA`;
-//! without it the tests print a note and pass.
+//! The data is found by `mocap-testdata` (`<workspace>/../shared/data` or
+//! `$MOCAP_SHARED_DATA`); without it the tests print a note and pass.
 
 use std::path::PathBuf;
 
@@ -15,10 +15,7 @@ use mocap_style::{
 };
 
 fn bandai(set: &str, name: &str) -> Option<PathBuf> {
-    let dir = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let path = dir.join("bandai").join(set).join(name);
+    let path = mocap_testdata::shared(format!("bandai/{set}/{name}"))?;
     if path.is_file() {
         Some(path)
     } else {
@@ -190,10 +187,10 @@ fn same_style_transfer_keeps_the_feet_planted() {
 /// contact and held the ankle up to 2.6 m from where the leg was, with the
 /// foot out nearly a whole leg length from under its hip (0.96; real walks
 /// at most 0.55). The sad walk's strides are far too short for the brisk
-/// walk's path, so its feet slide whatever the legs do (114 cm/s on flat
-/// feet with session 19's model); the cleanup now moves an ankle at most
-/// about a quarter of a leg (25 cm), keeps the feet under the body (reach
-/// 0.40 leg lengths) and leaves the rest of the sliding (107 cm/s).
+/// walk's path, so its feet slide whatever the legs do (about 114 cm/s on
+/// flat feet); the cleanup moves an ankle at most about a quarter of a leg
+/// (25 cm), keeps the feet under the body (reach 0.40 leg lengths) and
+/// leaves the rest of the sliding (about 107 cm/s).
 #[test]
 fn the_contact_cleanup_keeps_a_shuffling_styles_legs_under_the_body() {
     let Some(Pair {
@@ -262,8 +259,9 @@ fn a_style_clip_of_a_rig_without_body_parts_is_refused() {
     let Some(src) = bandai("dataset-1", "dataset-1_walk_normal_001.bvh") else {
         return;
     };
-    let other = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/parser-cases/bvhanim_test_simple.bvh");
+    let Some(other) = mocap_testdata::shared("parser-cases/bvhanim_test_simple.bvh") else {
+        return;
+    };
     if !other.exists() {
         eprintln!("note: no parser-case BVH; skipping");
         return;
@@ -282,18 +280,16 @@ fn a_style_clip_of_a_rig_without_body_parts_is_refused() {
 /// A bundled walk with the performer turned by `degrees` about the
 /// vertical.
 fn bundled_turned(name: &str, degrees: f32) -> mocap_core::Motion {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../samples")
-        .join(name);
+    let path = mocap_testdata::sample(name);
     let rotation = mocap_core::rotation::Quat::from_rotation_y(degrees.to_radians());
     mocap_core::ops::turn(&read_bvh(&path).unwrap(), rotation).unwrap()
 }
 
 /// The output does not depend on which way the style clip's performer
-/// faces. The style's statistics take the clip and its mirror image; until
-/// session 13 a performer facing between the world axes was mirrored with
-/// twisted midline joints, and turning the proud walk by 45 degrees
-/// changed the output (258 frames instead of 249). Runs on the bundled
+/// faces. The style's statistics take the clip and its mirror image, so a
+/// performer facing between the world axes must be mirrored without
+/// twisting the midline joints; otherwise turning the proud walk by 45
+/// degrees changes the output (258 frames instead of 249). Runs on the bundled
 /// samples.
 #[test]
 fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
@@ -446,9 +442,7 @@ fn restyled_with(
 /// output's mean sideways foot offset back towards the source's. Six
 /// held-out right turns of six styles, restyled with a held-out straight
 /// walk: 0.0134 body heights from the source's on average, 0.0597 without
-/// (session 21's model; session 19's: 0.0073 and 0.0493; session 18's:
-/// 0.0052 and 0.0542, and 0.0068 with one offset per clip); the test asserts
-/// at most a quarter.
+/// (the shipped model); the test asserts at most a quarter.
 #[test]
 fn restyled_turns_keep_their_sideways_footwork() {
     use mocap_style::Asymmetry;
@@ -497,20 +491,17 @@ fn restyled_turns_keep_their_sideways_footwork() {
 /// A take that walks straight and then turns keeps each part's footwork:
 /// the source's asymmetry is averaged over two strides around each frame
 /// (the default), not over the whole take, where the turn's offset was
-/// spread over the straight part and halved in the turn (`source-clip`,
-/// session 16). Three held-out straight walks each joined to a held-out
+/// spread over the straight part and halved in the turn (`source-clip`).
+/// Three held-out straight walks each joined to a held-out
 /// right turn of the same style, restyled with a held-out walk of another
 /// style; the output is cut where the source's walk ends. Mean over the
 /// parts of |output - source| of the feet's sideways offset: 0.0113 body
-/// heights against 0.0172 with session 21's model, trained three times as
-/// long (session 19's: 0.0080 against 0.0181, session 18's: 0.0038 against
-/// 0.0177). Over the 14 joined takes of the `asymmetry_along` example (84
-/// outputs per fold), 0.0105 / 0.0086 for the first / second clip against
-/// 0.0207 / 0.0226 (session 19's model: 0.0086 / 0.0077 against 0.0238 /
-/// 0.0188), and 0.0102 / 0.0101 against 0.0147 / 0.0209 on the other fold.
-/// The test asserts at most 0.75 of the whole-take offset's error (0.6
-/// until session 21: these three takes came out at 0.66 with the longer
-/// trained model, where the 14-take study gives 0.44 and 0.57).
+/// heights against 0.0172 with the shipped model. Over the 14 joined takes
+/// of the study `style_asymmetry_along` (84 outputs per fold), 0.0105 /
+/// 0.0086 for the first / second clip against 0.0207 / 0.0226, and 0.0102 /
+/// 0.0101 against 0.0147 / 0.0209 on the other fold. The test asserts at
+/// most 0.75 of the whole-take offset's error (these three takes give
+/// 0.66, where the 14-take study gives 0.44 and 0.57).
 #[test]
 fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
     use mocap_core::ops::trim;
@@ -581,9 +572,8 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
 /// held-out walk decoded from its own latent codes (strength 0, no style)
 /// keeps a flat foot nearly as still as the take does. The seven held-out
 /// dataset-2 straight walks: 10.1 cm/s of flat-foot sliding against the
-/// takes' 7.5 with session 21's model (session 19's: 10.3); session 18's
-/// model, trained without that loss, gave 22.0. The test asserts at most twice the
-/// takes'.
+/// takes' 7.5 with the shipped model; a model trained without that loss
+/// gave 22.0. The test asserts at most twice the takes'.
 #[test]
 fn the_autoencoder_keeps_a_flat_foot_nearly_still() {
     use mocap_style::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter};
