@@ -450,7 +450,7 @@ pub fn root_from_feet(
     }
 }
 
-/// How far [`root_from_feet`] moved the root from its own path,
+/// How far `root_from_feet` moved the root from its own path,
 /// horizontally, in file units.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct RootShift {

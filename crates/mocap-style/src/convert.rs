@@ -147,12 +147,12 @@ pub enum RootPath {
     Source,
     /// Along the source's path over spans longer than a second (its shape
     /// and length), carried by the planted feet within a stride
-    /// ([`crate::contact::root_from_feet`] with
-    /// [`crate::contact::RootFromFeetOptions::keep_source_path_seconds`]).
+    /// (`root_from_feet` with
+    /// `RootFromFeetOptions::keep_source_path_seconds`).
     #[default]
     FeetAlongSource,
     /// Carried by the planted feet everywhere: the path's shape and length
-    /// follow the strides ([`crate::contact::root_from_feet`]).
+    /// follow the strides (`root_from_feet`).
     Feet,
 }
 
@@ -297,7 +297,7 @@ pub struct ConvertOptions {
     /// Frames over which the strength rises from 0 (0: no fade).
     pub fade_in_frames: f32,
     /// Pin the feet during ground contacts after decoding
-    /// ([`crate::contact`]); applied by [`crate::apply::restyle`].
+    /// ([`crate::clean_foot_contacts`]); applied by [`crate::apply::restyle`].
     #[serde(default)]
     pub foot_contacts: bool,
     /// Where the root goes ([`RootPath`]); applied by
@@ -728,7 +728,7 @@ pub fn asymmetry_track(
 /// at the ends), or over the whole clip when `window` is `None`. A Hann
 /// window of `l` frames has a spectrum that vanishes at every multiple of
 /// 2/l cycles per frame, so with `l` two strides long it cancels whatever
-/// repeats with the stride ([`asymmetry_track`]).
+/// repeats with the stride ([`Asymmetry::Source`]).
 pub fn windowed_mean(values: &[f64], dim: usize, window: Option<usize>) -> Vec<f32> {
     let frames = values.len() / dim.max(1);
     let mut data = Vec::with_capacity(frames * dim);

@@ -537,10 +537,10 @@ fn sideways_ankle_values() -> [usize; 2] {
 }
 
 /// The mean over frames of the two ankles' sideways offsets from the pelvis
-/// in the body frame ([`sideways_ankle_values`], summed). About zero in a
-/// straight walk, well off it in a turn (its feet land to one side): how
-/// turn_cues.sh and the tests tell whether a restyled turn kept its
-/// footwork.
+/// in the body frame (mocap-search's `left_ankle.x` and `right_ankle.x`,
+/// summed). About zero in a straight walk, well off it in a turn (its feet
+/// land to one side): how the studies and the tests tell whether a restyled
+/// turn kept its footwork.
 pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
     let statistics = crate::classify::clip_pose_statistics(motion)?;
     Ok(sideways_ankle_values()

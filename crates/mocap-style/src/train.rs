@@ -91,7 +91,7 @@ pub struct TrainOptions {
     pub resume: bool,
     /// Hidden and latent sizes and kernel (channels come from the data).
     pub network: AutoencoderConfig,
-    /// Weight of the loss on the feet ([`crate::foot_loss`]) added to the
+    /// Weight of the loss on the feet (`foot_loss`) added to the
     /// reconstruction error; 0: the report's loss alone.
     #[serde(default)]
     pub foot_loss_weight: f64,
