@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use mocap_core::io::bvh::read_bvh;
-use mocap_style::eval::{foot_skating, planted_foot_sliding};
-use mocap_style::features::RigLayout;
+use mocap_style::{foot_skating, planted_foot_sliding, RigLayout};
 
 fn mocap(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mocap"))
@@ -455,8 +454,8 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
 }
 
 /// Most a straight walk may move, mean over joints and frames, when its small
-/// left-right asymmetry is kept (the bundled walk restyled as proud: 2.1
-/// degrees with the shipped model in session 16, 2.2 with session 19's).
+/// left-right asymmetry is kept (the bundled walk restyled as proud: about 2
+/// degrees with the shipped model).
 const ASYMMETRY_CHANGE_MAX_DEG: f32 = 4.0;
 
 #[test]
@@ -499,14 +498,13 @@ fn style_apply_restyles_the_bundled_walk() {
 
     // On the source's path (the report's root) the flat feet slide; carried
     // by the planted feet within each stride (the default) or everywhere,
-    // the same restyle slides them less (session 19's model: 42.5 cm/s on
-    // the path, 37.5 along it, 26.5 carried everywhere; the coarse foot
-    // skating, which counts toes swinging low, moves less: 66.9, 64.5,
-    // 54.8), and the report says how far the feet moved the root. Only the default and the source's path keep the
-    // distance the source covers.
+    // the same restyle slides them less, and the report says how far the
+    // feet moved the root (the coarse foot skating, which counts toes
+    // swinging low, moves less). Only the default and the source's path
+    // keep the distance the source covers.
     let (path_report, path_motion) = restyle(&["--root", "source"]);
     let (along_report, along_motion) = restyle(&[]);
-    let (feet_report, feet_motion) = restyle(&["--root-from-feet"]);
+    let (feet_report, feet_motion) = restyle(&["--root", "feet"]);
     assert_eq!(path_report["root"], "source");
     assert_eq!(along_report["root"], "feet-along-source");
     assert_eq!(feet_report["root"], "feet");

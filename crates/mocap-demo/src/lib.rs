@@ -62,7 +62,7 @@ const EMBEDDED: &[(&str, &[u8])] = &[
     ),
     (
         "models/style-default.safetensors",
-        mocap_style::train::DEFAULT_MODEL,
+        mocap_style::DEFAULT_MODEL,
     ),
 ];
 
@@ -315,7 +315,7 @@ macro_rules! stage_error_from {
 stage_error_from!(
     mocap_core::Error,
     mocap_clean::CleanError,
-    mocap_style::StyleError,
+    mocap_nn::CapabilityError,
     mocap_search::SearchError,
     std::io::Error
 );

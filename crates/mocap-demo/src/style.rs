@@ -2,7 +2,7 @@
 //! `apply`, elastic patches, the shipped style model).
 
 use mocap_core::io::bvh::read_bvh;
-use mocap_style::apply::{apply, ApplyOptions};
+use mocap_style::{apply, ApplyOptions};
 use mocap_view::{render_files, Layout, RenderOptions};
 
 use crate::{require_file, viewer_command, StageContext, StageReport, StageResult, StageStop};

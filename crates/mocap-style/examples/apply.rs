@@ -1,15 +1,14 @@
-//! Restyles a clip (what `mocap style apply` will do).
+//! Restyles a clip: the library call behind `mocap style apply`.
 //!
 //! ```text
 //! cargo run --release -p mocap-style --example apply -- SOURCE --style STYLE_CLIP -o out.bvh \
-//!     [--model M.safetensors] [--strength 0.7] [--no-elastic] [--method adain] \
+//!     [--model M.safetensors] [--strength 0.7] [--method fixed-patches] \
 //!     [--fade-in 2] [--blend OTHER_STYLE_CLIP:0.5] [--patch 32]
 //! ```
 
 use std::path::PathBuf;
 
-use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::Method;
+use mocap_style::{apply, parse_blend, ApplyOptions};
 
 fn main() {
     let mut options = ApplyOptions::new("", "", "out.bvh");
@@ -18,11 +17,10 @@ fn main() {
         while let Some(a) = args.next() {
             let mut value = || args.next().unwrap_or_else(|| panic!("{a} needs a value"));
             match a.as_str() {
-                "-o" | "--out" => options.out = PathBuf::from(value()),
+                "-o" | "--output" => options.out = PathBuf::from(value()),
                 "--style" => options.style = PathBuf::from(value()),
                 "--model" => options.model = Some(PathBuf::from(value())),
                 "--strength" => options.strength = value().parse().expect("--strength X"),
-                "--no-elastic" => options.method = Method::FixedPatches,
                 "--method" => options.method = value().parse()?,
                 "--fade-in" => {
                     options.fade_in_seconds = value()

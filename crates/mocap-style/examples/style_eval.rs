@@ -1,16 +1,16 @@
-//! Evaluates style transfer on labelled clips (what `mocap style eval` will do).
+//! Evaluates style transfer on labelled clips: the library call behind
+//! `mocap style eval`.
 //!
 //! ```text
 //! cargo run --release -p mocap-style --example style_eval -- \
 //!     [--model M.safetensors] [--sources walk,walk-turn-left] [--styles walk] \
-//!     [--classifier-contents walk,walk-back] [--style-judge forest|conv-net] [--seed S] [--patch 32] [--asymmetry source|source-clip|style] [--foot-contacts] [--root-from-feet] [--filmstrips DIR] \
+//!     [--classifier-contents walk,walk-back] [--style-judge forest|conv-net] [--seed S] [--patch 32] [--asymmetry source|source-clip|style] [--foot-contacts] [--root feet] [--filmstrips DIR] \
 //!     [--json report.json] [--markdown report.md] DIR...
 //! ```
 
 use std::path::PathBuf;
 
-use mocap_style::convert::RootPath;
-use mocap_style::eval::{evaluate, EvalOptions};
+use mocap_style::{evaluate, EvalOptions};
 
 fn main() {
     let mut options = EvalOptions::default();
@@ -32,7 +32,6 @@ fn main() {
             "--styles" => options.style_contents = list(value()),
             "--classifier-contents" => options.classifier_filter.contents = list(value()),
             "--foot-contacts" => options.convert.foot_contacts = true,
-            "--root-from-feet" => options.convert.root = RootPath::Feet,
             "--root" => options.convert.root = value().parse().expect("--root PATH"),
             "--asymmetry" => {
                 options.convert.asymmetry = value()

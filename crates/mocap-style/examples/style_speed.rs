@@ -17,10 +17,10 @@ use std::path::PathBuf;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::ops::trim;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{
-    load_model, prepare_style, restyle, source_reconstruction_deg, StageTimings,
+use mocap_style::{
+    load_model, prepare_style, restyle, source_reconstruction_deg, Asymmetry, ConvertOptions,
+    Method, RootPath, StageTimings,
 };
-use mocap_style::convert::{Asymmetry, ConvertOptions, Method, RootPath};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));

@@ -1,4 +1,4 @@
-//! Trains the style autoencoder (what `mocap style train` will do).
+//! Trains the style autoencoder: the library call behind `mocap style train`.
 //!
 //! ```text
 //! cargo run --release -p mocap-style --example style_train -- \
@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{train, TrainOptions};
 
 fn main() {
     let mut options = TrainOptions::default();
@@ -16,7 +16,7 @@ fn main() {
     while let Some(a) = args.next() {
         let mut value = || args.next().unwrap_or_else(|| panic!("{a} needs a value"));
         match a.as_str() {
-            "-o" | "--out" => options.out = PathBuf::from(value()),
+            "-o" | "--output" => options.out = PathBuf::from(value()),
             "--epochs" => options.epochs = value().parse().expect("--epochs N"),
             "--steps" => options.steps_per_epoch = value().parse().expect("--steps N"),
             "--seed" => options.seed = value().parse().expect("--seed N"),

@@ -45,8 +45,7 @@ use crate::convert::{
     Method, RootPath, StyleInput,
 };
 use crate::data::mirrored;
-use crate::eval::gait_period;
-use crate::features::{compose, decompose, sample_frames, RootTrack};
+use crate::features::{compose, decompose, gait_period, sample_frames, RootTrack};
 use crate::train::StyleModel;
 use crate::{invalid, Result};
 
@@ -61,7 +60,8 @@ pub struct ApplyOptions {
     pub model: Option<PathBuf>,
     /// 1: full style; 0: the source (default 1).
     pub strength: f32,
-    /// `ElasticPatches` (default); `FixedPatches` for `--no-elastic`.
+    /// `ElasticPatches` (default) or `FixedPatches` (keeps the source's
+    /// timing); the baselines of the evaluation too.
     pub method: Method,
     /// Seconds over which the style fades in (0: none).
     pub fade_in_seconds: f64,
@@ -243,12 +243,11 @@ pub fn source_reconstruction_deg(model: &StyleModel, source: &Motion) -> Result<
 
 /// A source whose [`source_reconstruction_deg`] exceeds this is far from the
 /// motion the shipped model was trained on, and its content is likely lost.
-/// Measured with the shipped model on every Bandai clip (`familiarity`
-/// example; bench/results/style.md, "Sources the model cannot
+/// Measured with the shipped model on every Bandai clip (the study
+/// `style_familiarity`; bench/results/style.md, "Sources the model cannot
 /// reproduce"): above 7 degrees lie 1.7% of the clips of the walking
 /// contents it was trained on and 90.1% of the others (gestures, runs,
-/// kicks...; session 19's model: 2.4% and 94.0%; session 18's: 2.7% and
-/// 93.7%).
+/// kicks...).
 pub const UNFAMILIAR_SOURCE_DEG: f32 = 7.0;
 
 /// [`ApplyReport::model`] when the shipped model restyled.

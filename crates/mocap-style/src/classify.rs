@@ -38,7 +38,7 @@ pub enum Descriptor {
     /// (pose statistics, independent of timing).
     Statistics,
     /// [`Descriptor::Statistics`] plus how the body moves, which is where a
-    /// style shows when the poses are alike (see [`gait_row`]): rates of
+    /// style shows when the poses are alike (see `gait_row`): rates of
     /// change of every feature, direction-free walking speed, step period
     /// and regularity, and the spectra of the signals a gait swings.
     Gait,
@@ -351,7 +351,7 @@ pub enum Model {
     /// counted twice.
     Discriminant,
     /// A small 1-D convolutional network on the window's per-frame values
-    /// (not the descriptor; see [`crate::classify_net`]); a clip's label is
+    /// (not the descriptor; see `classify_net`); a clip's label is
     /// the class with the largest summed probability over its windows.
     ConvNet,
     /// Both [`Model::Forest`] and [`Model::ConvNet`], their votes added

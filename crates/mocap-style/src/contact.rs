@@ -53,8 +53,8 @@ pub struct ContactOptions {
     /// brushing the ground in a swing).
     pub min_frames: usize,
     /// End a contact where the foot moves forward relative to the pelvis
-    /// (see the module docs); `false`: by height alone, as before session
-    /// 18 (kept to measure the two side by side, example `foot_cleanup`).
+    /// (see the module docs); `false`: by height alone (kept to measure the
+    /// two side by side, the study `style_foot_cleanup`).
     pub split_at_swing: bool,
     /// Longest hip-to-ankle distance a held ankle may ask for, as a fraction
     /// of the leg's length (thigh plus shin): a correction reaching further
@@ -66,12 +66,12 @@ pub struct ContactOptions {
 }
 
 impl Default for ContactOptions {
-    /// Chosen in session 18 on the evaluation's held-out pairs (example
-    /// `foot_cleanup`, bench/results/style.md, "Foot-contact cleanup"),
+    /// Chosen on the evaluation's held-out pairs (the study
+    /// `style_foot_cleanup`, bench/results/style.md, "Foot-contact cleanup"),
     /// without the style judges: the reach limit, 1.02, among 0.99, 1,
     /// 1.02, 1.05 and 1.1 as the least flat-foot sliding before more
     /// outputs put a foot out further than any real clip; the height
-    /// tolerance, 3% of the leg length (5% before), among 2%, 3% and 5%: as
+    /// tolerance, 3% of the leg length, among 2%, 3% and 5%: as
     /// little flat-foot sliding as 5%, less jitter and no foot out of reach
     /// more than without the cleanup.
     fn default() -> Self {
@@ -450,7 +450,7 @@ pub fn root_from_feet(
     }
 }
 
-/// How far [`root_from_feet`] moved the root from its own path,
+/// How far `root_from_feet` moved the root from its own path,
 /// horizontally, in file units.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct RootShift {

@@ -17,8 +17,8 @@
 //!    48`, a source stride that matches the style best when shrunk to 36
 //!    frames comes out 48 frames long, at the style's pace. Fixed patches
 //!    always take `L = P`. (The report does not give `P`; 48 was chosen on
-//!    one fold of the Bandai takes and judged on the other, 32 before
-//!    session 24: bench/results/style.md, "The patch length, again".)
+//!    one fold of the Bandai takes and judged on the other:
+//!    bench/results/style.md, "The patch length, again".)
 //! 3. Seams: a second series of patches, offset by half a patch (each from
 //!    the centre of one stretched patch to the centre of the next), is
 //!    matched too, and the two are blended with linear weights along time
@@ -49,7 +49,7 @@
 //!    a turn keeps the side its feet are placed to. Averaged over two
 //!    strides rather than the whole clip, a take that walks straight and
 //!    then turns keeps each part's own offset; [`Asymmetry::SourceClip`]
-//!    keeps one offset for the whole clip (session 16), and
+//!    keeps one offset for the whole clip, and
 //!    [`Asymmetry::Style`] leaves it out (the report's method).
 //!
 //! The baselines of the evaluation: [`Method::WhiteningColouring`] colours
@@ -147,12 +147,12 @@ pub enum RootPath {
     Source,
     /// Along the source's path over spans longer than a second (its shape
     /// and length), carried by the planted feet within a stride
-    /// ([`crate::contact::root_from_feet`] with
-    /// [`crate::contact::RootFromFeetOptions::keep_source_path_seconds`]).
+    /// (`root_from_feet` with
+    /// `RootFromFeetOptions::keep_source_path_seconds`).
     #[default]
     FeetAlongSource,
     /// Carried by the planted feet everywhere: the path's shape and length
-    /// follow the strides ([`crate::contact::root_from_feet`]).
+    /// follow the strides (`root_from_feet`).
     Feet,
 }
 
@@ -194,7 +194,7 @@ pub enum Asymmetry {
     /// offset for the whole clip ([`Asymmetry::SourceClip`]).
     #[default]
     Source,
-    /// The source's, one offset for the whole clip (session 16): the
+    /// The source's, one offset for the whole clip: the
     /// half-difference of the mean latent codes of the source and its
     /// mirror.
     SourceClip,
@@ -297,7 +297,7 @@ pub struct ConvertOptions {
     /// Frames over which the strength rises from 0 (0: no fade).
     pub fade_in_frames: f32,
     /// Pin the feet during ground contacts after decoding
-    /// ([`crate::contact`]); applied by [`crate::apply::restyle`].
+    /// ([`crate::clean_foot_contacts`]); applied by [`crate::apply::restyle`].
     #[serde(default)]
     pub foot_contacts: bool,
     /// Where the root goes ([`RootPath`]); applied by
@@ -355,7 +355,7 @@ impl ConvertOptions {
             return Err(invalid(format!(
                 "elastic patches stretch a patch by up to {:.0}% in steps of {} frames, so a \
                  patch of {} frames cannot stretch: use a patch of {} frames or more, or fixed \
-                 patches (--no-elastic)",
+                 patches (--method fixed-patches)",
                 self.stretch * 100.0,
                 self.stretch_step,
                 self.patch,
@@ -728,7 +728,7 @@ pub fn asymmetry_track(
 /// at the ends), or over the whole clip when `window` is `None`. A Hann
 /// window of `l` frames has a spectrum that vanishes at every multiple of
 /// 2/l cycles per frame, so with `l` two strides long it cancels whatever
-/// repeats with the stride ([`asymmetry_track`]).
+/// repeats with the stride ([`Asymmetry::Source`]).
 pub fn windowed_mean(values: &[f64], dim: usize, window: Option<usize>) -> Vec<f32> {
     let frames = values.len() / dim.max(1);
     let mut data = Vec::with_capacity(frames * dim);

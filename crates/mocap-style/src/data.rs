@@ -184,30 +184,14 @@ pub fn mirrored(motion: &Motion) -> Result<Motion> {
 
 #[cfg(test)]
 pub(crate) mod test_support {
-    use std::path::PathBuf;
-
     use mocap_core::io::bvh::read_bvh;
     use mocap_core::Motion;
 
-    /// `<workspace>/../shared/data` or `$MOCAP_SHARED_DATA`, if present.
-    pub fn shared_data() -> Option<PathBuf> {
-        let dir = std::env::var_os("MOCAP_SHARED_DATA")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| {
-                PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
-            });
-        if dir.is_dir() {
-            Some(dir)
-        } else {
-            eprintln!("note: shared data not found at {}; skipping", dir.display());
-            None
-        }
-    }
-
-    /// A Bandai take by file name (dataset from the name), if the data is there.
+    /// A Bandai take by file name (dataset from the name), if the shared
+    /// data is there.
     pub fn bandai_walk(name: &str) -> Option<Motion> {
         let set = name.split('_').next()?;
-        let path = shared_data()?.join("bandai").join(set).join(name);
+        let path = mocap_testdata::shared(format!("bandai/{set}/{name}"))?;
         Some(read_bvh(&path).expect("readable Bandai take"))
     }
 }

@@ -10,7 +10,7 @@
 //!    pose features, described by posture, rates of change, walking speed,
 //!    step period and spectra (not the autoencoder's features, so the
 //!    classifiers do not share its biases). They are chosen on real clips
-//!    ([`check_classifiers`]), never on the method's outputs.
+//!    (the study `style_classifiers`), never on the method's outputs.
 //! 2. Every pair (source, style clip) of test clips, the source's content in
 //!    `source_contents` and the style clip's in `style_contents`, is
 //!    restyled with every method ([`Method`]).
@@ -40,12 +40,12 @@ use serde::{Deserialize, Serialize};
 use crate::apply::{
     load_model, prepare_source, prepare_style, restyle_prepared, StageTimings, StyleClip,
 };
-pub use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
+use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
 use crate::contact::{flat_foot_steps, heights_above_ground, travelled};
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake};
-use crate::features::{up_axis, RigLayout};
+use crate::features::{gait_period, up_axis, RigLayout};
 use crate::filmstrip::{draw_filmstrip, FilmstripRow};
 use crate::train::StyleModel;
 use crate::{invalid, Result};
@@ -119,7 +119,7 @@ pub enum StyleJudge {
     /// The small conv net on per-frame values and their changes, trained on
     /// the clips and their mirror images (a second opinion).
     ConvNet,
-    /// Both, their votes added with equal weight (session 20).
+    /// Both, their votes added with equal weight.
     Both,
 }
 
@@ -156,6 +156,37 @@ impl EvalOptions {
                 self.net.velocities = true;
                 self.style_mirror_training = true;
             }
+        }
+    }
+
+    /// The settings of the evaluation's style classifier.
+    pub fn style_classifier_config(&self) -> ClassifierConfig {
+        ClassifierConfig {
+            model: self.style_model,
+            descriptor: self.style_descriptor,
+            windows: self.style_windows,
+            trees: self.trees,
+            candidates: self.candidates,
+            mirror_training: self.style_mirror_training,
+            shrinkage: self.shrinkage,
+            net: self.net,
+            seed: self.seed,
+        }
+    }
+
+    /// The settings of the evaluation's content classifier (trained on the
+    /// clips as they are, with the next seed).
+    pub fn content_classifier_config(&self) -> ClassifierConfig {
+        ClassifierConfig {
+            model: self.content_model,
+            descriptor: self.content_descriptor,
+            windows: self.content_windows,
+            trees: self.trees,
+            candidates: self.candidates,
+            mirror_training: false,
+            shrinkage: self.shrinkage,
+            net: self.net,
+            seed: self.seed + 1,
         }
     }
 }
@@ -319,67 +350,6 @@ pub struct EvalReport {
     pub options: EvalOptions,
     pub sets: Vec<SetReport>,
     pub seconds: f64,
-}
-
-/// The gait period in seconds: the lag of the strongest autocorrelation of
-/// the feet's heights between 0.4 and 2.5 s (the smallest lag within 90% of
-/// the best, so that two strides are not taken for one). `None` when the
-/// clip is too short or the feet do not move periodically (best
-/// autocorrelation below 0.2).
-pub fn gait_period(motion: &Motion, rig: &RigLayout) -> Option<f64> {
-    let poses = forward_kinematics(motion);
-    let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let fps = motion.fps();
-    let n = poses.frame_count;
-    let min_lag = (0.4 * fps).round() as usize;
-    let max_lag = ((2.5 * fps).round() as usize).min(n.saturating_sub(n / 4));
-    if max_lag <= min_lag + 2 {
-        return None;
-    }
-    let signal = |joint: usize| -> Vec<f64> {
-        let h: Vec<f64> = (0..n)
-            .map(|f| poses.position(f, joint).dot(up) as f64)
-            .collect();
-        let mean = h.iter().sum::<f64>() / n as f64;
-        h.into_iter().map(|x| x - mean).collect()
-    };
-    let feet = [signal(rig.left_foot[0]), signal(rig.right_foot[0])];
-    // Normalised autocorrelation (mean over the overlap), summed over feet.
-    let energy: f64 = feet
-        .iter()
-        .map(|s| s.iter().map(|x| x * x).sum::<f64>() / n as f64)
-        .sum();
-    if energy < 1e-9 {
-        return None;
-    }
-    let r: Vec<f64> = (0..=max_lag)
-        .map(|lag| {
-            feet.iter()
-                .map(|s| (0..n - lag).map(|t| s[t] * s[t + lag]).sum::<f64>() / (n - lag) as f64)
-                .sum::<f64>()
-                / energy
-        })
-        .collect();
-    let peaks: Vec<usize> = (min_lag.max(1)..max_lag)
-        .filter(|&l| r[l] >= r[l - 1] && r[l] >= r[l + 1])
-        .collect();
-    let best = peaks
-        .iter()
-        .map(|&l| r[l])
-        .fold(f64::NEG_INFINITY, f64::max);
-    if best < 0.2 {
-        return None;
-    }
-    let lag = *peaks.iter().find(|&&l| r[l] >= 0.9 * best)?;
-    // Parabolic interpolation of the peak for sub-frame precision.
-    let (a, b, c) = (r[lag - 1], r[lag], r[lag + 1]);
-    let denom = a - 2.0 * b + c;
-    let offset = if denom.abs() > 1e-12 {
-        0.5 * (a - c) / denom
-    } else {
-        0.0
-    };
-    Some((lag as f64 + offset.clamp(-0.5, 0.5)) / fps)
 }
 
 /// Foot skating: the mean horizontal speed (file units per second) of the
@@ -557,7 +527,7 @@ impl MotionMeasures {
 /// Where the left and the right ankle's sideways offsets from the pelvis
 /// (body frame, body heights) are among mocap-search's per-frame pose values
 /// (`left_ankle.x`, `right_ankle.x`).
-pub fn sideways_ankle_values() -> [usize; 2] {
+fn sideways_ankle_values() -> [usize; 2] {
     ["left_ankle.x", "right_ankle.x"].map(|name| {
         mocap_search::features::VALUE_NAMES
             .iter()
@@ -567,10 +537,10 @@ pub fn sideways_ankle_values() -> [usize; 2] {
 }
 
 /// The mean over frames of the two ankles' sideways offsets from the pelvis
-/// in the body frame ([`sideways_ankle_values`], summed). About zero in a
-/// straight walk, well off it in a turn (its feet land to one side): how
-/// turn_cues.sh and the tests tell whether a restyled turn kept its
-/// footwork.
+/// in the body frame (mocap-search's `left_ankle.x` and `right_ankle.x`,
+/// summed). About zero in a straight walk, well off it in a turn (its feet
+/// land to one side): how the studies and the tests tell whether a restyled
+/// turn kept its footwork.
 pub fn feet_sideways_offset(motion: &Motion) -> Result<f64> {
     let statistics = crate::classify::clip_pose_statistics(motion)?;
     Ok(sideways_ankle_values()
@@ -605,184 +575,6 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     })
 }
 
-/// The evaluation classifiers' accuracy on real clips of one set, without
-/// restyling anything: to compare classifiers, see [`check_classifiers`].
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ClassifierCheck {
-    pub set: String,
-    /// On the held-out clips (style: those of the classifier's contents),
-    /// trained on all the others, as in [`evaluate`].
-    pub held_out_style: f64,
-    pub held_out_style_clips: usize,
-    pub held_out_content: f64,
-    pub held_out_content_clips: usize,
-    /// Cross-validation on the training clips only (the held-out clips are
-    /// not used): style leaving one content out at a time (a style must be
-    /// recognised in a content it was not trained on), content leaving one
-    /// style out at a time. `None` when not asked for.
-    pub cross_validated_style: Option<f64>,
-    pub cross_validated_content: Option<f64>,
-    /// The held-out clips the style classifier got wrong, with its answer.
-    pub style_errors: Vec<(String, String)>,
-    /// The same for the content classifier.
-    pub content_errors: Vec<(String, String)>,
-}
-
-/// Which cross-validations [`check_classifiers`] runs.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct CrossValidate {
-    pub style: bool,
-    pub content: bool,
-}
-
-/// Measures the classifiers of [`evaluate`] on real clips of every set of
-/// `options.inputs` (held-out accuracy and, as asked,
-/// cross-validation on the training clips), so that the evaluation's
-/// classifiers can be chosen on real clips, never on the method's outputs.
-pub fn check_classifiers(
-    options: &EvalOptions,
-    cross_validate: CrossValidate,
-) -> Result<Vec<ClassifierCheck>> {
-    let files = labelled_paths(&list_bvh(&options.inputs)?, &ClipFilter::default())?;
-    let mut sets: BTreeMap<String, Vec<(PathBuf, crate::data::Labels)>> = BTreeMap::new();
-    for f in files {
-        sets.entry(f.1.set.clone()).or_default().push(f);
-    }
-    let mut out = Vec::new();
-    for (set, files) in sets {
-        let held = held_out(&files, options.held_out_take);
-        let (test, train): (Vec<_>, Vec<_>) = files.iter().cloned().partition(|(p, _)| {
-            held.contains(
-                &p.file_stem()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .into_owned(),
-            )
-        });
-        let train = load_clips(&train)?;
-        let test = load_clips(&test)?;
-        let (style, content) = train_classifiers(&train, options)?;
-        let style_tests: Vec<&Clip> = test
-            .iter()
-            .filter(|c| options.classifier_filter.accepts(&c.labels))
-            .collect();
-        let mut style_errors = Vec::new();
-        for c in &style_tests {
-            let p = style.predict(&c.motion)?;
-            if p != c.labels.style {
-                style_errors.push((c.name.clone(), p));
-            }
-        }
-        let mut content_errors = Vec::new();
-        for c in &test {
-            let p = content.predict(&c.motion)?;
-            if p != c.labels.content {
-                content_errors.push((c.name.clone(), p));
-            }
-        }
-        let style_hits = style_tests.len() - style_errors.len();
-        let content_hits = test.len() - content_errors.len();
-        let (mut cv_style, mut cv_content) = (None, None);
-        if cross_validate.style {
-            let style_clips: Vec<Clip> = train
-                .iter()
-                .filter(|c| options.classifier_filter.accepts(&c.labels))
-                .cloned()
-                .collect();
-            let mut folds: Vec<String> = style_clips
-                .iter()
-                .map(|c| c.labels.content.clone())
-                .collect();
-            folds.sort();
-            folds.dedup();
-            let (mut hits, mut n) = (0, 0);
-            for fold in &folds {
-                let (inside, outside): (Vec<Clip>, Vec<Clip>) = style_clips
-                    .iter()
-                    .cloned()
-                    .partition(|c| &c.labels.content == fold);
-                if outside.is_empty() {
-                    continue;
-                }
-                let classifier = ClipClassifier::train(
-                    &outside
-                        .iter()
-                        .map(|c| (c, c.labels.style.clone()))
-                        .collect::<Vec<_>>(),
-                    style_config(options),
-                )?;
-                for c in &inside {
-                    hits += (classifier.predict(&c.motion)? == c.labels.style) as usize;
-                    n += 1;
-                }
-            }
-            cv_style = Some(hits as f64 / n.max(1) as f64);
-        }
-        if cross_validate.content {
-            let mut folds: Vec<String> = train.iter().map(|c| c.labels.style.clone()).collect();
-            folds.sort();
-            folds.dedup();
-            let (mut hits, mut n) = (0, 0);
-            for fold in &folds {
-                let (inside, outside): (Vec<Clip>, Vec<Clip>) =
-                    train.iter().cloned().partition(|c| &c.labels.style == fold);
-                let classifier = ClipClassifier::train(
-                    &outside
-                        .iter()
-                        .map(|c| (c, c.labels.content.clone()))
-                        .collect::<Vec<_>>(),
-                    content_config(options),
-                )?;
-                for c in &inside {
-                    hits += (classifier.predict(&c.motion)? == c.labels.content) as usize;
-                    n += 1;
-                }
-            }
-            cv_content = Some(hits as f64 / n.max(1) as f64);
-        }
-        out.push(ClassifierCheck {
-            set,
-            held_out_style: style_hits as f64 / style_tests.len().max(1) as f64,
-            held_out_style_clips: style_tests.len(),
-            held_out_content: content_hits as f64 / test.len().max(1) as f64,
-            held_out_content_clips: test.len(),
-            cross_validated_style: cv_style,
-            cross_validated_content: cv_content,
-            style_errors,
-            content_errors,
-        });
-    }
-    Ok(out)
-}
-
-fn style_config(options: &EvalOptions) -> ClassifierConfig {
-    ClassifierConfig {
-        model: options.style_model,
-        descriptor: options.style_descriptor,
-        windows: options.style_windows,
-        trees: options.trees,
-        candidates: options.candidates,
-        mirror_training: options.style_mirror_training,
-        shrinkage: options.shrinkage,
-        net: options.net,
-        seed: options.seed,
-    }
-}
-
-fn content_config(options: &EvalOptions) -> ClassifierConfig {
-    ClassifierConfig {
-        model: options.content_model,
-        descriptor: options.content_descriptor,
-        windows: options.content_windows,
-        trees: options.trees,
-        candidates: options.candidates,
-        mirror_training: false,
-        shrinkage: options.shrinkage,
-        net: options.net,
-        seed: options.seed + 1,
-    }
-}
-
 /// The style classifier (trained on the clips `options.classifier_filter`
 /// accepts) and the content classifier (every clip) of a set.
 pub fn train_classifiers(
@@ -795,14 +587,14 @@ pub fn train_classifiers(
             .filter(|c| options.classifier_filter.accepts(&c.labels))
             .map(|c| (c, c.labels.style.clone()))
             .collect::<Vec<_>>(),
-        style_config(options),
+        options.style_classifier_config(),
     )?;
     let content = ClipClassifier::train(
         &clips
             .iter()
             .map(|c| (c, c.labels.content.clone()))
             .collect::<Vec<_>>(),
-        content_config(options),
+        options.content_classifier_config(),
     )?;
     Ok((style, content))
 }

@@ -227,6 +227,67 @@ pub fn up_axis(positions: &[Vec3], joint_count: usize, layout: &RigLayout) -> Ve
     }
 }
 
+/// The gait period in seconds: the lag of the strongest autocorrelation of
+/// the feet's heights between 0.4 and 2.5 s (the smallest lag within 90% of
+/// the best, so that two strides are not taken for one). `None` when the
+/// clip is too short or the feet do not move periodically (best
+/// autocorrelation below 0.2).
+pub fn gait_period(motion: &Motion, rig: &RigLayout) -> Option<f64> {
+    let poses = forward_kinematics(motion);
+    let up = up_axis(&poses.positions, poses.joint_count, rig);
+    let fps = motion.fps();
+    let n = poses.frame_count;
+    let min_lag = (0.4 * fps).round() as usize;
+    let max_lag = ((2.5 * fps).round() as usize).min(n.saturating_sub(n / 4));
+    if max_lag <= min_lag + 2 {
+        return None;
+    }
+    let signal = |joint: usize| -> Vec<f64> {
+        let h: Vec<f64> = (0..n)
+            .map(|f| poses.position(f, joint).dot(up) as f64)
+            .collect();
+        let mean = h.iter().sum::<f64>() / n as f64;
+        h.into_iter().map(|x| x - mean).collect()
+    };
+    let feet = [signal(rig.left_foot[0]), signal(rig.right_foot[0])];
+    // Normalised autocorrelation (mean over the overlap), summed over feet.
+    let energy: f64 = feet
+        .iter()
+        .map(|s| s.iter().map(|x| x * x).sum::<f64>() / n as f64)
+        .sum();
+    if energy < 1e-9 {
+        return None;
+    }
+    let r: Vec<f64> = (0..=max_lag)
+        .map(|lag| {
+            feet.iter()
+                .map(|s| (0..n - lag).map(|t| s[t] * s[t + lag]).sum::<f64>() / (n - lag) as f64)
+                .sum::<f64>()
+                / energy
+        })
+        .collect();
+    let peaks: Vec<usize> = (min_lag.max(1)..max_lag)
+        .filter(|&l| r[l] >= r[l - 1] && r[l] >= r[l + 1])
+        .collect();
+    let best = peaks
+        .iter()
+        .map(|&l| r[l])
+        .fold(f64::NEG_INFINITY, f64::max);
+    if best < 0.2 {
+        return None;
+    }
+    let lag = *peaks.iter().find(|&&l| r[l] >= 0.9 * best)?;
+    // Parabolic interpolation of the peak for sub-frame precision.
+    let (a, b, c) = (r[lag - 1], r[lag], r[lag + 1]);
+    let denom = a - 2.0 * b + c;
+    let offset = if denom.abs() > 1e-12 {
+        0.5 * (a - c) / denom
+    } else {
+        0.0
+    };
+    Some((lag as f64 + offset.clamp(-0.5, 0.5)) / fps)
+}
+
 /// A fixed horizontal axis for heading angles: the first world axis that is
 /// not the up axis.
 fn horizontal_reference(up: Vec3) -> Vec3 {

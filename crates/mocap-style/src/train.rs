@@ -29,7 +29,7 @@ use mocap_nn::checkpoint::{
 };
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
-use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
+use mocap_nn::train::{epoch_seed, optimizer_step, run_epochs, EpochPlan, History};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -91,7 +91,7 @@ pub struct TrainOptions {
     pub resume: bool,
     /// Hidden and latent sizes and kernel (channels come from the data).
     pub network: AutoencoderConfig,
-    /// Weight of the loss on the feet ([`crate::foot_loss`]) added to the
+    /// Weight of the loss on the feet (`foot_loss`) added to the
     /// reconstruction error; 0: the report's loss alone.
     #[serde(default)]
     pub foot_loss_weight: f64,
@@ -547,9 +547,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         plan,
         |run, epoch, _step| -> Result<f64> {
             if run.rng_epoch != epoch {
-                run.rng = ChaCha8Rng::seed_from_u64(
-                    options.seed ^ (epoch as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15),
-                );
+                run.rng = ChaCha8Rng::seed_from_u64(epoch_seed(options.seed, epoch));
                 run.rng_epoch = epoch;
             }
             let (x, frames, contacts) = sampler.batch(&mut run.rng, options.batch_size);

@@ -1,26 +1,21 @@
 //! Style transfer with the shipped default model on Bandai Namco takes.
 //!
-//! The data is found at `<workspace>/../shared/data` or `$MOCAP_SHARED_DATA`;
-//! without it the tests print a note and pass.
+//! The data is found by `mocap-testdata` (`<workspace>/../shared/data` or
+//! `$MOCAP_SHARED_DATA`); without it the tests print a note and pass.
 
 use std::path::PathBuf;
 
 use mocap_core::forward_kinematics;
 use mocap_core::io::bvh::read_bvh;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{apply, prepare_style, restyle, ApplyOptions, StageTimings};
-use mocap_style::convert::{ConvertOptions, Method};
-use mocap_style::eval::{
-    feet_sideways_offset, foot_skating, gait_period, largest_foot_reach, planted_foot_sliding,
+use mocap_style::{
+    apply, feet_sideways_offset, foot_skating, gait_period, largest_foot_reach,
+    planted_foot_sliding, prepare_style, restyle, ApplyOptions, ConvertOptions, Method, RigLayout,
+    StageTimings, StyleModel,
 };
-use mocap_style::features::RigLayout;
-use mocap_style::train::StyleModel;
 
 fn bandai(set: &str, name: &str) -> Option<PathBuf> {
-    let dir = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    let path = dir.join("bandai").join(set).join(name);
+    let path = mocap_testdata::shared(format!("bandai/{set}/{name}"))?;
     if path.is_file() {
         Some(path)
     } else {
@@ -33,7 +28,7 @@ fn bandai(set: &str, name: &str) -> Option<PathBuf> {
 struct Pair {
     model: StyleModel,
     source: mocap_core::Motion,
-    clip: mocap_style::apply::StyleClip,
+    clip: mocap_style::StyleClip,
     timings: StageTimings,
     rig: RigLayout,
 }
@@ -192,10 +187,10 @@ fn same_style_transfer_keeps_the_feet_planted() {
 /// contact and held the ankle up to 2.6 m from where the leg was, with the
 /// foot out nearly a whole leg length from under its hip (0.96; real walks
 /// at most 0.55). The sad walk's strides are far too short for the brisk
-/// walk's path, so its feet slide whatever the legs do (114 cm/s on flat
-/// feet with session 19's model); the cleanup now moves an ankle at most
-/// about a quarter of a leg (25 cm), keeps the feet under the body (reach
-/// 0.40 leg lengths) and leaves the rest of the sliding (107 cm/s).
+/// walk's path, so its feet slide whatever the legs do (about 114 cm/s on
+/// flat feet); the cleanup moves an ankle at most about a quarter of a leg
+/// (25 cm), keeps the feet under the body (reach 0.40 leg lengths) and
+/// leaves the rest of the sliding (about 107 cm/s).
 #[test]
 fn the_contact_cleanup_keeps_a_shuffling_styles_legs_under_the_body() {
     let Some(Pair {
@@ -264,8 +259,9 @@ fn a_style_clip_of_a_rig_without_body_parts_is_refused() {
     let Some(src) = bandai("dataset-1", "dataset-1_walk_normal_001.bvh") else {
         return;
     };
-    let other = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/parser-cases/bvhanim_test_simple.bvh");
+    let Some(other) = mocap_testdata::shared("parser-cases/bvhanim_test_simple.bvh") else {
+        return;
+    };
     if !other.exists() {
         eprintln!("note: no parser-case BVH; skipping");
         return;
@@ -284,18 +280,16 @@ fn a_style_clip_of_a_rig_without_body_parts_is_refused() {
 /// A bundled walk with the performer turned by `degrees` about the
 /// vertical.
 fn bundled_turned(name: &str, degrees: f32) -> mocap_core::Motion {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../samples")
-        .join(name);
+    let path = mocap_testdata::sample(name);
     let rotation = mocap_core::rotation::Quat::from_rotation_y(degrees.to_radians());
     mocap_core::ops::turn(&read_bvh(&path).unwrap(), rotation).unwrap()
 }
 
 /// The output does not depend on which way the style clip's performer
-/// faces. The style's statistics take the clip and its mirror image; until
-/// session 13 a performer facing between the world axes was mirrored with
-/// twisted midline joints, and turning the proud walk by 45 degrees
-/// changed the output (258 frames instead of 249). Runs on the bundled
+/// faces. The style's statistics take the clip and its mirror image, so a
+/// performer facing between the world axes must be mirrored without
+/// twisting the midline joints; otherwise turning the proud walk by 45
+/// degrees changes the output (258 frames instead of 249). Runs on the bundled
 /// samples.
 #[test]
 fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
@@ -338,12 +332,13 @@ fn a_style_clip_turned_about_the_vertical_gives_the_same_output() {
 /// and with the forest's votes added (`--style-judge both`).
 #[test]
 fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
-    use mocap_style::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
-    use mocap_style::classify_net::NetConfig;
-    use mocap_style::data::{labelled_paths, load_clips, ClipFilter};
+    use mocap_style::{
+        labelled_paths, load_clips, ClassifierConfig, ClassifierModel, ClipClassifier, ClipFilter,
+        Descriptor, NetConfig, Windows,
+    };
 
     let styles = ["active", "elderly", "exhausted"];
-    let load = |takes: &[&str]| -> Option<Vec<mocap_style::data::Clip>> {
+    let load = |takes: &[&str]| -> Option<Vec<mocap_style::Clip>> {
         let mut paths = Vec::new();
         for style in styles {
             for take in takes {
@@ -380,8 +375,8 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     };
     // The conv net alone, and with the forest's votes added (the forest is
     // trained on the clips as they are, the net on their mirrors too).
-    let net = judge(Model::ConvNet, true);
-    let both = judge(Model::ForestAndConvNet, true);
+    let net = judge(ClassifierModel::ConvNet, true);
+    let both = judge(ClassifierModel::ForestAndConvNet, true);
     for judge in [&net, &both] {
         assert_eq!(judge.classes(), styles);
         let mut wrong = Vec::new();
@@ -395,7 +390,7 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
     }
     // The votes of both are the forest's (on the clips as they are) plus
     // the net's, same seeds.
-    let forest = judge(Model::Forest, false);
+    let forest = judge(ClassifierModel::Forest, false);
     for clip in &test {
         let (f, n, b) = (
             forest.votes(&clip.motion).unwrap(),
@@ -410,7 +405,7 @@ fn the_conv_net_judge_recognises_walking_styles_of_other_takes() {
 
 /// The shipped model and the held-out dataset-2 active walk, prepared as
 /// the style clip of the turn tests; `None` without the data.
-fn model_and_active_walk() -> Option<(StyleModel, mocap_style::apply::StyleClip)> {
+fn model_and_active_walk() -> Option<(StyleModel, mocap_style::StyleClip)> {
     let path = bandai("dataset-2", "dataset-2_walk_active_031.bvh")?;
     let model = StyleModel::default_model(DeviceChoice::Cpu).unwrap();
     let mut t = StageTimings::default();
@@ -421,10 +416,10 @@ fn model_and_active_walk() -> Option<(StyleModel, mocap_style::apply::StyleClip)
 /// `source` restyled with `clip` by the default settings but `asymmetry`.
 fn restyled_with(
     model: &StyleModel,
-    clip: &mocap_style::apply::StyleClip,
+    clip: &mocap_style::StyleClip,
     source: &mocap_core::Motion,
-    asymmetry: mocap_style::convert::Asymmetry,
-) -> mocap_style::apply::Restyled {
+    asymmetry: mocap_style::Asymmetry,
+) -> mocap_style::Restyled {
     let options = ConvertOptions {
         asymmetry,
         ..ConvertOptions::default()
@@ -447,12 +442,10 @@ fn restyled_with(
 /// output's mean sideways foot offset back towards the source's. Six
 /// held-out right turns of six styles, restyled with a held-out straight
 /// walk: 0.0134 body heights from the source's on average, 0.0597 without
-/// (session 21's model; session 19's: 0.0073 and 0.0493; session 18's:
-/// 0.0052 and 0.0542, and 0.0068 with one offset per clip); the test asserts
-/// at most a quarter.
+/// (the shipped model); the test asserts at most a quarter.
 #[test]
 fn restyled_turns_keep_their_sideways_footwork() {
-    use mocap_style::convert::Asymmetry;
+    use mocap_style::Asymmetry;
 
     let feet_offset = |motion: &mocap_core::Motion| feet_sideways_offset(motion).unwrap();
     let Some((model, clip)) = model_and_active_walk() else {
@@ -498,24 +491,21 @@ fn restyled_turns_keep_their_sideways_footwork() {
 /// A take that walks straight and then turns keeps each part's footwork:
 /// the source's asymmetry is averaged over two strides around each frame
 /// (the default), not over the whole take, where the turn's offset was
-/// spread over the straight part and halved in the turn (`source-clip`,
-/// session 16). Three held-out straight walks each joined to a held-out
+/// spread over the straight part and halved in the turn (`source-clip`).
+/// Three held-out straight walks each joined to a held-out
 /// right turn of the same style, restyled with a held-out walk of another
 /// style; the output is cut where the source's walk ends. Mean over the
 /// parts of |output - source| of the feet's sideways offset: 0.0113 body
-/// heights against 0.0172 with session 21's model, trained three times as
-/// long (session 19's: 0.0080 against 0.0181, session 18's: 0.0038 against
-/// 0.0177). Over the 14 joined takes of the `asymmetry_along` example (84
-/// outputs per fold), 0.0105 / 0.0086 for the first / second clip against
-/// 0.0207 / 0.0226 (session 19's model: 0.0086 / 0.0077 against 0.0238 /
-/// 0.0188), and 0.0102 / 0.0101 against 0.0147 / 0.0209 on the other fold.
-/// The test asserts at most 0.75 of the whole-take offset's error (0.6
-/// until session 21: these three takes came out at 0.66 with the longer
-/// trained model, where the 14-take study gives 0.44 and 0.57).
+/// heights against 0.0172 with the shipped model. Over the 14 joined takes
+/// of the study `style_asymmetry_along` (84 outputs per fold), 0.0105 /
+/// 0.0086 for the first / second clip against 0.0207 / 0.0226, and 0.0102 /
+/// 0.0101 against 0.0147 / 0.0209 on the other fold. The test asserts at
+/// most 0.75 of the whole-take offset's error (these three takes give
+/// 0.66, where the 14-take study gives 0.44 and 0.57).
 #[test]
 fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
     use mocap_core::ops::trim;
-    use mocap_style::convert::Asymmetry;
+    use mocap_style::Asymmetry;
 
     let Some((model, clip)) = model_and_active_walk() else {
         return;
@@ -582,12 +572,11 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
 /// held-out walk decoded from its own latent codes (strength 0, no style)
 /// keeps a flat foot nearly as still as the take does. The seven held-out
 /// dataset-2 straight walks: 10.1 cm/s of flat-foot sliding against the
-/// takes' 7.5 with session 21's model (session 19's: 10.3); session 18's
-/// model, trained without that loss, gave 22.0. The test asserts at most twice the
-/// takes'.
+/// takes' 7.5 with the shipped model; a model trained without that loss
+/// gave 22.0. The test asserts at most twice the takes'.
 #[test]
 fn the_autoencoder_keeps_a_flat_foot_nearly_still() {
-    use mocap_style::data::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter};
+    use mocap_style::{held_out, labelled_paths, list_bvh, load_clips, ClipFilter};
 
     let Some(active_walk) = bandai("dataset-2", "dataset-2_walk_active_031.bvh") else {
         return;

@@ -4,13 +4,10 @@
 //! `(seed, e)`, and the resumable state holds the weights and Adam's moments).
 //! Uses the two walks bundled in `samples/`.
 
-use std::path::PathBuf;
-
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{train, TrainOptions};
 
 #[test]
 fn a_resumed_run_matches_an_uninterrupted_one() {
-    let samples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../samples");
     let dir = tempfile::tempdir().unwrap();
     let takes = dir.path().join("walks");
     std::fs::create_dir(&takes).unwrap();
@@ -18,7 +15,7 @@ fn a_resumed_run_matches_an_uninterrupted_one() {
         "dataset-1_walk_normal_001.bvh",
         "dataset-1_walk_proud_001.bvh",
     ] {
-        std::fs::copy(samples.join(name), takes.join(name)).unwrap();
+        std::fs::copy(mocap_testdata::sample(name), takes.join(name)).unwrap();
     }
     let base = TrainOptions {
         inputs: vec![takes],

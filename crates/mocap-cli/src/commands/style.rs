@@ -4,13 +4,12 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context};
-use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{apply, parse_blend, ApplyOptions};
-use mocap_style::convert::{Asymmetry, Method, RootPath};
-use mocap_style::data::HeldOutTake;
-use mocap_style::eval::{evaluate, EvalOptions, StyleJudge};
-use mocap_style::train::{train, TrainOptions};
+use mocap_style::{
+    apply, evaluate, parse_blend, train, ApplyOptions, Asymmetry, EvalOptions, HeldOutTake, Method,
+    RootPath, StyleJudge, TrainOptions,
+};
 
+use super::args::{set, DeviceArgs, ReportArgs, TrainLoopArgs};
 use super::{write_output, GlobalOptions};
 
 #[derive(clap::Args)]
@@ -22,6 +21,10 @@ pub struct Args {
 #[derive(clap::Subcommand)]
 enum StyleCommand {
     /// Train the motion autoencoder on many styles (once; no training per style).
+    ///
+    /// The training loop's defaults are the report's: 30 epochs (the shipped model: 90, whose
+    /// validation loss was still falling at 30) of 100 batches, the validation loss measured
+    /// after each epoch; 16 windows per batch; Adam with learning rate 1e-4.
     Train(TrainArgs),
     /// Give SOURCE the style (and timing) of one example clip.
     Apply(ApplyArgs),
@@ -37,30 +40,15 @@ struct TrainArgs {
     /// The model file to write (safetensors).
     #[arg(long, short)]
     output: PathBuf,
+    #[command(flatten)]
+    training: TrainLoopArgs,
     /// Train on these contents only (comma separated; default: every clip in the folders; the
     /// shipped model: walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right).
     #[arg(long, value_delimiter = ',')]
     contents: Vec<String>,
-    /// Epochs of `--steps` batches (default 30; the shipped model: 90, whose validation loss was
-    /// still falling at 30: bench/results/style.md, "Longer training").
-    #[arg(long)]
-    epochs: Option<usize>,
-    /// Batches per epoch (default 100); the validation loss is measured after each epoch.
-    #[arg(long)]
-    steps: Option<usize>,
-    /// Windows per batch (default 16, the report's).
-    #[arg(long)]
-    batch: Option<usize>,
     /// Window length in frames (default 240, the report's).
     #[arg(long)]
     window: Option<usize>,
-    /// Adam's learning rate (default 1e-4, the report's).
-    #[arg(long)]
-    lr: Option<f64>,
-    /// Seed of the initial weights and of the windows drawn; the same seed and data give the
-    /// same model.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
     /// Weight of a loss on the feet added to the reconstruction error: flat feet of the clips
     /// stay still in the reconstruction (0: the report's loss; measured with 300 in
     /// bench/results/style.md, "A loss on the feet").
@@ -76,52 +64,21 @@ struct TrainArgs {
     /// last (the shipped model's fold) or first (the other fold).
     #[arg(long, default_value = "last", value_name = "last|first")]
     held_out: HeldOutTake,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
-    /// Loss curve PNG.
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// Continue from the last checkpoint of an interrupted run.
-    #[arg(long)]
-    resume: bool,
     /// Print the training report (data, losses per epoch, time) as JSON.
     #[arg(long)]
     json: bool,
 }
 
-#[derive(clap::Args)]
-struct ApplyArgs {
-    /// The motion to restyle (BVH, or AMC with its ASF beside it).
-    source: PathBuf,
-    /// One example clip of the style (BVH, or AMC with its ASF beside it; a clip of another rig is
-    /// retargeted onto the source's).
-    #[arg(long)]
-    style: PathBuf,
-    /// The restyled motion (BVH, the source's skeleton).
-    #[arg(long, short)]
-    output: PathBuf,
+/// How `style apply` and `style eval` restyle: the model, the patch length,
+/// where the body goes, the feet and the asymmetry.
+#[derive(clap::Args, Clone, Debug)]
+struct RestyleArgs {
     /// The autoencoder (default: the model shipped with mocap).
     #[arg(long)]
     model: Option<PathBuf>,
-    /// 1: full style, 0: the source; in between, the pose and (with elastic patches) the timing are
-    /// interpolated, so 0.5 lasts about halfway between the source and the full style.
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
-    strength: f32,
-    /// Fixed patches instead of elastic ones (the style's timing is not carried over).
-    #[arg(long)]
-    no_elastic: bool,
-    /// elastic-patches, fixed-patches, whitening-colouring or adain.
-    #[arg(long, conflicts_with = "no_elastic")]
-    method: Option<Method>,
-    /// Let the style fade in over this time, e.g. `2s` or `1.5`.
-    #[arg(long, value_name = "SECONDS")]
-    fade_in: Option<String>,
-    /// Blend with a second style: OTHER_STYLE_CLIP:WEIGHT.
-    #[arg(long, value_name = "CLIP:WEIGHT")]
-    blend: Option<String>,
-    /// Patch length in frames (default 48; even; the style clip needs at least this many).
-    /// Longer patches follow the style's timing more closely, shorter ones (32) its timing less.
+    /// Patch length in frames (default 48; even; a style clip needs at least this many, and
+    /// `eval` leaves out clips shorter than two patches). Longer patches follow the style's
+    /// timing more closely, shorter ones (32) less.
     #[arg(long)]
     patch: Option<usize>,
     /// Where the body goes: `feet-along-source` (default: the planted feet carry it within a
@@ -130,9 +87,6 @@ struct ApplyArgs {
     /// the distance covered follows the strides, reported as the distance ratio).
     #[arg(long, value_name = "PATH", default_value = "feet-along-source")]
     root: RootPath,
-    /// Same as `--root feet`.
-    #[arg(long, conflicts_with = "root")]
-    root_from_feet: bool,
     /// Pin the ankles on the ground by turning hips and knees, no further than the legs reach
     /// (keeps the source's path; costs some style, see bench/results/style.md).
     #[arg(long)]
@@ -148,9 +102,37 @@ struct ApplyArgs {
         default_value = "source"
     )]
     asymmetry: Asymmetry,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
+}
+
+#[derive(clap::Args)]
+struct ApplyArgs {
+    /// The motion to restyle (BVH, or AMC with its ASF beside it).
+    source: PathBuf,
+    /// One example clip of the style (BVH, or AMC with its ASF beside it; a clip of another rig is
+    /// retargeted onto the source's).
+    #[arg(long)]
+    style: PathBuf,
+    /// The restyled motion (BVH, the source's skeleton).
+    #[arg(long, short)]
+    output: PathBuf,
+    /// 1: full style, 0: the source; in between, the pose and (with elastic patches) the timing are
+    /// interpolated, so 0.5 lasts about halfway between the source and the full style.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    strength: f32,
+    /// elastic-patches (the style's timing is carried over), fixed-patches (the source's timing
+    /// is kept), whitening-colouring or adain.
+    #[arg(long, default_value = "elastic-patches", value_name = "METHOD")]
+    method: Method,
+    /// Let the style fade in over this time, e.g. `2s` or `1.5`.
+    #[arg(long, value_name = "SECONDS")]
+    fade_in: Option<String>,
+    /// Blend with a second style: OTHER_STYLE_CLIP:WEIGHT.
+    #[arg(long, value_name = "CLIP:WEIGHT")]
+    blend: Option<String>,
+    #[command(flatten)]
+    restyle: RestyleArgs,
+    #[command(flatten)]
+    device: DeviceArgs,
     /// Print what was done (timing, patches, root, retargeting, stage times) as JSON.
     #[arg(long)]
     json: bool,
@@ -161,9 +143,6 @@ struct EvalArgs {
     /// Folders or files of labelled clips (`<set>_<content>_<style>_<take>.bvh`).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
-    /// The autoencoder (default: the shipped model).
-    #[arg(long)]
-    model: Option<PathBuf>,
     /// Which take of each group is held out and tested: last, or first (the other fold; the
     /// model must have been trained with `style train --held-out first`).
     #[arg(long, default_value = "last", value_name = "last|first")]
@@ -180,25 +159,8 @@ struct EvalArgs {
     /// Contents the style classifier trains on (comma separated; default all).
     #[arg(long, value_delimiter = ',')]
     classifier_contents: Vec<String>,
-    /// Patch length in frames (default 48; clips shorter than two patches are left out).
-    #[arg(long)]
-    patch: Option<usize>,
-    /// Where the body goes, as `apply --root`.
-    #[arg(long, value_name = "PATH", default_value = "feet-along-source")]
-    root: RootPath,
-    /// Same as `--root feet`.
-    #[arg(long, conflicts_with = "root")]
-    root_from_feet: bool,
-    /// Restyle with the ankles pinned on the ground (as `apply --foot-contacts`).
-    #[arg(long)]
-    foot_contacts: bool,
-    /// Whose left-right asymmetry the outputs keep, as `apply --asymmetry`.
-    #[arg(
-        long,
-        value_name = "source|source-clip|style",
-        default_value = "source"
-    )]
-    asymmetry: Asymmetry,
+    #[command(flatten)]
+    restyle: RestyleArgs,
     /// Trees of each classifier's forest.
     #[arg(long, default_value_t = 100)]
     trees: usize,
@@ -209,19 +171,14 @@ struct EvalArgs {
     style_judge: StyleJudge,
     /// Seed of the classifiers.
     #[arg(long, default_value_t = 1)]
-    judge_seed: u64,
+    seed: u64,
     /// Write side-by-side filmstrips (source, style, output) here.
     #[arg(long)]
     filmstrips: Option<PathBuf>,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
-    /// Also write the Markdown tables to this file.
-    #[arg(long)]
-    markdown: Option<PathBuf>,
-    /// Print the report as JSON (every pair and method) instead of Markdown.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    device: DeviceArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// `2s`, `1.5s` or `1.5` seconds.
@@ -236,33 +193,83 @@ fn parse_seconds(text: &str) -> anyhow::Result<f64> {
     Ok(seconds)
 }
 
+fn train_options(a: TrainArgs) -> TrainOptions {
+    let mut options = TrainOptions {
+        inputs: a.inputs,
+        out: a.output,
+        hold_out: !a.no_hold_out,
+        held_out_take: a.held_out,
+        mirror: !a.no_mirror,
+        seed: a.training.seed,
+        device: a.training.device.device,
+        plot: a.training.plot,
+        resume: a.training.resume,
+        foot_loss_weight: a.foot_loss,
+        ..TrainOptions::default()
+    };
+    set(&mut options.window, a.window);
+    set(&mut options.batch_size, a.training.batch);
+    set(&mut options.learning_rate, a.training.lr);
+    set(&mut options.epochs, a.training.epochs);
+    set(&mut options.steps_per_epoch, a.training.steps);
+    if !a.contents.is_empty() {
+        options.filter.contents = a.contents;
+    }
+    options
+}
+
+fn apply_options(a: &ApplyArgs) -> anyhow::Result<ApplyOptions> {
+    let mut options = ApplyOptions::new(&a.source, &a.style, &a.output);
+    options.model = a.restyle.model.clone();
+    options.strength = a.strength;
+    options.method = a.method;
+    if let Some(text) = &a.fade_in {
+        options.fade_in_seconds = parse_seconds(text)?;
+    }
+    if let Some(text) = &a.blend {
+        options.blend = Some(parse_blend(text)?);
+    }
+    set(&mut options.patch, a.restyle.patch);
+    options.root = a.restyle.root;
+    options.foot_contacts = a.restyle.foot_contacts;
+    options.asymmetry = a.restyle.asymmetry;
+    options.device = a.device.device;
+    Ok(options)
+}
+
+fn eval_options(a: EvalArgs) -> EvalOptions {
+    let mut options = EvalOptions {
+        inputs: a.inputs,
+        model: a.restyle.model,
+        held_out_take: a.held_out,
+        source_contents: a.sources,
+        style_contents: a.styles,
+        trees: a.trees,
+        filmstrips: a.filmstrips,
+        device: a.device.device,
+        ..EvalOptions::default()
+    };
+    if !a.methods.is_empty() {
+        options.methods = a.methods;
+    }
+    if !a.classifier_contents.is_empty() {
+        options.classifier_filter.contents = a.classifier_contents;
+    }
+    set(&mut options.convert.patch, a.restyle.patch);
+    options.convert.root = a.restyle.root;
+    options.convert.foot_contacts = a.restyle.foot_contacts;
+    options.convert.asymmetry = a.restyle.asymmetry;
+    options.set_style_judge(a.style_judge);
+    options.seed = a.seed;
+    options
+}
+
 pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     match args.command {
         StyleCommand::Train(a) => {
-            let defaults = TrainOptions::default();
-            let mut train_options = TrainOptions {
-                inputs: a.inputs,
-                out: a.output,
-                hold_out: !a.no_hold_out,
-                held_out_take: a.held_out,
-                mirror: !a.no_mirror,
-                window: a.window.unwrap_or(defaults.window),
-                batch_size: a.batch.unwrap_or(defaults.batch_size),
-                learning_rate: a.lr.unwrap_or(defaults.learning_rate),
-                epochs: a.epochs.unwrap_or(defaults.epochs),
-                steps_per_epoch: a.steps.unwrap_or(defaults.steps_per_epoch),
-                seed: a.seed,
-                device: a.device,
-                plot: a.plot,
-                resume: a.resume,
-                foot_loss_weight: a.foot_loss,
-                ..defaults
-            };
-            if !a.contents.is_empty() {
-                train_options.filter.contents = a.contents;
-            }
-            let report = train(&train_options)?;
-            if a.json {
+            let json = a.json;
+            let report = train(&train_options(a))?;
+            if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else if !options.quiet {
                 let last = report.history.epochs.last();
@@ -277,32 +284,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             }
         }
         StyleCommand::Apply(a) => {
-            let mut apply_options = ApplyOptions::new(&a.source, &a.style, &a.output);
-            apply_options.model = a.model;
-            apply_options.strength = a.strength;
-            apply_options.method = match (a.method, a.no_elastic) {
-                (Some(m), _) => m,
-                (None, true) => Method::FixedPatches,
-                (None, false) => Method::ElasticPatches,
-            };
-            if let Some(text) = &a.fade_in {
-                apply_options.fade_in_seconds = parse_seconds(text)?;
-            }
-            if let Some(text) = &a.blend {
-                apply_options.blend = Some(parse_blend(text)?);
-            }
-            if let Some(patch) = a.patch {
-                apply_options.patch = patch;
-            }
-            apply_options.root = if a.root_from_feet {
-                RootPath::Feet
-            } else {
-                a.root
-            };
-            apply_options.foot_contacts = a.foot_contacts;
-            apply_options.asymmetry = a.asymmetry;
-            apply_options.device = a.device;
-            let report = apply(&apply_options)?;
+            let report = apply(&apply_options(&a)?)?;
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else if !options.quiet {
@@ -335,41 +317,13 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             }
         }
         StyleCommand::Eval(a) => {
-            let mut eval_options = EvalOptions {
-                inputs: a.inputs,
-                model: a.model,
-                held_out_take: a.held_out,
-                source_contents: a.sources,
-                style_contents: a.styles,
-                trees: a.trees,
-                filmstrips: a.filmstrips,
-                device: a.device,
-                ..EvalOptions::default()
-            };
-            if !a.methods.is_empty() {
-                eval_options.methods = a.methods;
-            }
-            if !a.classifier_contents.is_empty() {
-                eval_options.classifier_filter.contents = a.classifier_contents;
-            }
-            if let Some(patch) = a.patch {
-                eval_options.convert.patch = patch;
-            }
-            eval_options.convert.root = if a.root_from_feet {
-                RootPath::Feet
-            } else {
-                a.root
-            };
-            eval_options.convert.foot_contacts = a.foot_contacts;
-            eval_options.convert.asymmetry = a.asymmetry;
-            eval_options.set_style_judge(a.style_judge);
-            eval_options.seed = a.judge_seed;
-            let report = evaluate(&eval_options)?;
+            let report_args = a.report.clone();
+            let report = evaluate(&eval_options(a))?;
             let markdown = report.to_markdown();
-            if let Some(path) = &a.markdown {
+            if let Some(path) = &report_args.markdown {
                 write_output(Some(path), |w| w.write_all(markdown.as_bytes()))?;
             }
-            let text = if a.json {
+            let text = if report_args.json {
                 serde_json::to_string_pretty(&report)? + "\n"
             } else {
                 markdown

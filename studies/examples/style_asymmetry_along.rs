@@ -1,12 +1,12 @@
 //! Takes that walk straight and then turn (or turn and then walk straight),
 //! restyled with the source's left-right asymmetry kept along time (the
 //! default, `--asymmetry source`), kept as one offset for the whole clip
-//! (`source-clip`, session 16) and not kept (`style`, the report's method):
+//! (`source-clip`) and not kept (`style`, the report's method):
 //! does each part keep its own footwork? (bench/results/style.md, "Turns
 //! kept along the take").
 //!
 //! ```text
-//! cargo run -p mocap-style --example asymmetry_along -- DIR \
+//! cargo run --release -p mocap-studies --example style_asymmetry_along -- DIR \
 //!     [--held-out last|first] [--model M]
 //! ```
 //!
@@ -32,14 +32,11 @@ use std::path::PathBuf;
 use mocap_core::ops::trim;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{
-    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings,
+use mocap_style::{
+    feet_sideways_offset, held_out, labelled_paths, list_bvh, load_clips, load_model,
+    prepare_source, prepare_style, restyle_prepared, train_classifiers, Asymmetry, Clip,
+    ClipFilter, ConvertOptions, EvalOptions, HeldOutTake, StageTimings,
 };
-use mocap_style::convert::{Asymmetry, ConvertOptions};
-use mocap_style::data::{
-    held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake,
-};
-use mocap_style::eval::{feet_sideways_offset, train_classifiers, EvalOptions};
 
 fn feet_offset(motion: &Motion) -> f64 {
     feet_sideways_offset(motion).expect("pose values")
@@ -84,7 +81,7 @@ fn main() {
         .unwrap_or_default();
     let model_path = option("--model").map(PathBuf::from);
     let [dir] = args.as_slice() else {
-        eprintln!("usage: asymmetry_along DIR [--held-out last|first] [--model M]");
+        eprintln!("usage: style_asymmetry_along DIR [--held-out last|first] [--model M]");
         std::process::exit(2);
     };
     let files = labelled_paths(

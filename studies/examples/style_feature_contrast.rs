@@ -4,13 +4,13 @@
 //! "The other fold").
 //!
 //! ```text
-//! cargo run -p mocap-style --example feature_contrast -- \
+//! cargo run --release -p mocap-studies --example style_feature_contrast -- \
 //!     DIR CONTENT_A CONTENT_B FILE... [--top 12]
 //! ```
 //!
 //! Every clip of `DIR` whose labels say `CONTENT_A` or `CONTENT_B` gives the
 //! mean and the deviation over its frames of each of the judges' pose values
-//! (`mocap_style::classify::clip_pose_statistics`). A
+//! (`mocap_style::clip_pose_statistics`). A
 //! value's separation is the difference of the two contents' averages over
 //! their clips, in units of the pooled spread between clips; the values that
 //! separate most are printed with the average of `FILE...` placed on the
@@ -20,8 +20,7 @@ use std::path::{Path, PathBuf};
 
 use mocap_core::io::read_motion;
 use mocap_search::features::VALUE_NAMES;
-use mocap_style::classify::clip_pose_statistics;
-use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
+use mocap_style::{clip_pose_statistics, labelled_paths, list_bvh, ClipFilter};
 
 /// Per clip: the mean, then the deviation, of every pose value over its frames.
 fn clip_statistics(path: &Path) -> Vec<f64> {
@@ -49,7 +48,7 @@ fn main() {
         args.drain(i..i + 2);
     }
     let [dir, a, b, files @ ..] = args.as_slice() else {
-        eprintln!("usage: feature_contrast DIR CONTENT_A CONTENT_B FILE... [--top N]");
+        eprintln!("usage: style_feature_contrast DIR CONTENT_A CONTENT_B FILE... [--top N]");
         std::process::exit(2);
     };
     let labelled = labelled_paths(

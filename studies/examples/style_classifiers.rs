@@ -3,7 +3,7 @@
 //! Used to choose the classifiers on real clips, never on outputs.
 //!
 //! ```text
-//! cargo run -p mocap-style --example classifiers -- [--cv | --cv-style | --cv-content] \
+//! cargo run --release -p mocap-studies --example style_classifiers -- [--cv | --cv-style | --cv-content] \
 //!     [--classifier-contents walk,walk-back] [--style-descriptor gait] \
 //!     [--content-descriptor intervals-gait] [--style-window 2] [--content-window 2] \
 //!     [--style-model forest|nearest-mean|discriminant|conv-net] [--style-judge forest|conv-net|both] [--shrinkage 0.5] [--content-model M] [--seed S] [--mirror] [--candidates N] [--trees 100] \
@@ -12,7 +12,8 @@
 
 use std::path::PathBuf;
 
-use mocap_style::eval::{check_classifiers, CrossValidate, EvalOptions};
+use mocap_studies::style::{check_classifiers, CrossValidate};
+use mocap_style::EvalOptions;
 
 fn main() {
     let mut options = EvalOptions::default();

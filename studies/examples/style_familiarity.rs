@@ -1,9 +1,9 @@
 //! How well the style autoencoder reproduces each clip with no style
-//! ([`mocap_style::apply::source_reconstruction_deg`]), by set and content:
-//! the measurement behind [`mocap_style::apply::UNFAMILIAR_SOURCE_DEG`].
+//! ([`mocap_style::source_reconstruction_deg`]), by set and content:
+//! the measurement behind [`mocap_style::UNFAMILIAR_SOURCE_DEG`].
 //!
 //! ```text
-//! cargo run -p mocap-style --example familiarity -- [--model M.safetensors] \
+//! cargo run --release -p mocap-studies --example style_familiarity -- [--model M.safetensors] \
 //!     [--trained-on walk,walk-back,...] DIR...
 //! ```
 //!
@@ -15,8 +15,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{load_model, source_reconstruction_deg};
-use mocap_style::data::{labelled_paths, list_bvh, ClipFilter, WALKING_CONTENTS};
+use mocap_style::{
+    labelled_paths, list_bvh, load_model, source_reconstruction_deg, ClipFilter, WALKING_CONTENTS,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut model_path = None;

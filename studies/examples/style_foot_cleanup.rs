@@ -1,44 +1,40 @@
 //! The foot-contact cleanup (`--foot-contacts`) measured on the evaluation's
-//! held-out pairs, as it was before session 18 and as it is now
-//! (bench/results/style.md, "Foot-contact cleanup").
+//! held-out pairs, with contacts found by height alone and with the current
+//! settings (bench/results/style.md, "Foot-contact cleanup").
 //!
 //! ```text
-//! cargo run -p mocap-style --example foot_cleanup -- DIR... [--held-out last|first] [--model M]
+//! cargo run --release -p mocap-studies --example style_foot_cleanup -- DIR... [--held-out last|first] [--model M]
 //! ```
 //!
 //! For every set folder, the held-out walks and turns are restyled with every
 //! held-out walk of another take (default settings, no cleanup), as
 //! `mocap style eval` pairs them. Each output is then cleaned three ways: not
 //! at all; with contacts found by height alone and no limit on the leg's
-//! reach (the cleanup before session 18); and with the current settings
+//! reach; and with the current settings
 //! (`ContactOptions::default()`: contacts also end where the foot swings
 //! forward past the body, and an ankle is moved only as far as the leg
 //! reaches). The table gives, per set and way, the means over the pairs of
-//! the evaluation's foot measures (`eval::foot_skating`,
-//! `eval::planted_foot_sliding`), the number of outputs with a foot further
+//! the evaluation's foot measures (`foot_skating`,
+//! `planted_foot_sliding`), the number of outputs with a foot further
 //! out from under its hip than in any of the set's real sources and style clips
-//! (`eval::largest_foot_reach`), the largest ankle shift, and the jitter.
+//! (`largest_foot_reach`), the largest ankle shift, and the jitter.
 //! A second table splits the outputs with no cleanup into quarters by how
 //! far the style clip's pace (pelvis distance per second) is from the pace
 //! the output's path asks for (the source's distance over the output's
 //! duration), with their flat-foot sliding.
 //! The classifiers are not run: style and content accuracy come from
-//! `style_eval --foot-contacts`.
+//! `mocap style eval --foot-contacts`.
 
 use std::path::PathBuf;
 
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_style::apply::{
-    load_model, prepare_source, prepare_style, restyle_prepared, StageTimings,
+use mocap_style::{
+    clean_foot_contacts, held_out, labelled_paths, largest_foot_reach, list_bvh, load_clips,
+    load_model, planted_foot_sliding, prepare_source, prepare_style, restyle_prepared, travelled,
+    ClipFilter, ContactOptions, ConvertOptions, HeldOutTake, MotionMeasures, RigLayout,
+    StageTimings, WALKING_CONTENTS,
 };
-use mocap_style::contact::{clean_foot_contacts, travelled, ContactOptions};
-use mocap_style::convert::ConvertOptions;
-use mocap_style::data::{
-    held_out, labelled_paths, list_bvh, load_clips, ClipFilter, HeldOutTake, WALKING_CONTENTS,
-};
-use mocap_style::eval::{largest_foot_reach, planted_foot_sliding, MotionMeasures};
-use mocap_style::features::RigLayout;
 
 const SOURCES: [&str; 3] = ["walk", "walk-turn-left", "walk-turn-right"];
 
@@ -88,7 +84,7 @@ fn main() {
     });
     if args.is_empty() {
         eprintln!(
-            "usage: foot_cleanup DIR... [--held-out last|first] [--model M] [--reach-limits A,B,..] \
+            "usage: style_foot_cleanup DIR... [--held-out last|first] [--model M] [--reach-limits A,B,..] \
              [--height-tolerances A,B,..]"
         );
         std::process::exit(2);
@@ -105,17 +101,17 @@ fn main() {
     let mut ways = vec![
         ("no cleanup".to_string(), None),
         (
-            "cleanup before session 18 (height alone, no reach limit)".to_string(),
+            "cleanup by height alone, no reach limit".to_string(),
             Some(before),
         ),
         (
-            "cleanup now (default)".to_string(),
+            "cleanup (default)".to_string(),
             Some(ContactOptions::default()),
         ),
     ];
     for &height_tolerance in &tolerances {
         ways.push((
-            format!("cleanup now, height tolerance {height_tolerance}"),
+            format!("cleanup, height tolerance {height_tolerance}"),
             Some(ContactOptions {
                 height_tolerance,
                 ..ContactOptions::default()
@@ -124,7 +120,7 @@ fn main() {
     }
     for &reach_limit in &reach_limits {
         ways.push((
-            format!("cleanup now, reach limit {reach_limit}"),
+            format!("cleanup, reach limit {reach_limit}"),
             Some(ContactOptions {
                 reach_limit,
                 ..ContactOptions::default()

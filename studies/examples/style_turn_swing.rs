@@ -3,13 +3,13 @@
 //! "Turns kept along the take".)
 //!
 //! ```text
-//! cargo run -p mocap-style --example turn_swing -- DIR STYLE_CLIP TURN...
+//! cargo run --release -p mocap-studies --example style_turn_swing -- DIR STYLE_CLIP TURN...
 //! ```
 //!
 //! For every clip, each ankle's sideways offset from the pelvis in the body
 //! frame (mocap-search's pose values `left_ankle.x`, `right_ankle.x`, body
 //! heights) is split in two: its mean over two of the clip's strides around
-//! each frame (`convert::windowed_mean`, the Hann window the asymmetry is
+//! each frame (`mocap_style::windowed_mean`, the Hann window the asymmetry is
 //! averaged over), which follows the clip as it walks in, turns and walks
 //! out; and the rest, the swing within each stride. The table gives the
 //! standard deviation of each part over the clip's frames, averaged over
@@ -22,12 +22,22 @@ use std::path::PathBuf;
 use mocap_core::io::read_motion;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_search::features::motion_features;
-use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
-use mocap_style::convert::{windowed_mean, Asymmetry, ConvertOptions};
-use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
-use mocap_style::eval::{gait_period, sideways_ankle_values};
-use mocap_style::features::RigLayout;
+use mocap_search::features::{motion_features, VALUE_NAMES};
+use mocap_style::{
+    gait_period, labelled_paths, list_bvh, load_model, prepare_style, restyle, windowed_mean,
+    Asymmetry, ClipFilter, ConvertOptions, RigLayout, StageTimings,
+};
+
+/// Where the left and the right ankle's sideways offsets from the pelvis
+/// (body frame, body heights) are among mocap-search's per-frame pose values.
+fn sideways_ankle_values() -> [usize; 2] {
+    ["left_ankle.x", "right_ankle.x"].map(|name| {
+        VALUE_NAMES
+            .iter()
+            .position(|n| *n == name)
+            .expect("a pose value of mocap-search")
+    })
+}
 
 /// (slow, swing) standard deviations of the left and right ankles' sideways
 /// offsets; `None` for a clip without a gait.
@@ -73,7 +83,7 @@ fn row(name: &str, motions: &[Motion]) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [dir, style, turns @ ..] = args.as_slice() else {
-        eprintln!("usage: turn_swing DIR STYLE_CLIP TURN...");
+        eprintln!("usage: style_turn_swing DIR STYLE_CLIP TURN...");
         std::process::exit(2);
     };
     let read =
