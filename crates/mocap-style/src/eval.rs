@@ -1183,7 +1183,7 @@ fn draw_filmstrips(
         for (m, motion) in &outputs {
             rows.push(FilmstripRow::new(format!("output: {}", m.name()), motion));
         }
-        draw_filmstrip(&path, &rows, &model.description.rig, 8)?;
+        draw_filmstrip(&path, &rows, 8)?;
         paths.push(path);
     }
     Ok(paths)

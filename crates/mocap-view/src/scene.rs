@@ -428,19 +428,19 @@ fn round_to(v: f32, scale: f32) -> f32 {
 }
 
 /// `#rrggbb`.
-pub fn hex_colour([r, g, b]: [u8; 3]) -> String {
+pub(crate) fn hex_colour([r, g, b]: [u8; 3]) -> String {
     format!("#{r:02x}{g:02x}{b:02x}")
 }
 
 /// The file name without its extension, for legends.
-pub fn file_label(path: &Path) -> String {
+pub(crate) fn file_label(path: &Path) -> String {
     path.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string())
 }
 
 /// Smallest and largest coordinates of `points`.
-pub fn bounding_box(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
+pub(crate) fn bounding_box(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
     let first = *points.first()?;
     Some(
         points
@@ -533,20 +533,10 @@ fn is_capture(path: &Path) -> bool {
 /// them.
 pub fn read_capture(path: &Path) -> Result<Vec<ViewMotion>> {
     use mocap_core::bodymap::KINECT_V2_JOINTS;
-    use mocap_core::error::{Location, ParseError};
     use std::collections::BTreeMap;
 
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let at = |line: usize, message: String| {
-        Error::Parse(ParseError {
-            location: Location {
-                path: path.to_path_buf(),
-                line,
-                column: 1,
-            },
-            message,
-        })
-    };
+    let at = |line: usize, message: String| Error::parse(path, line, 1, message);
     let joint_count = KINECT_V2_JOINTS.len();
     // Per stream (a sensor id, or None for fused frames): (time, points, confidence).
     type Frame = (f64, Vec<Vec3>, Vec<f32>);
