@@ -19,7 +19,7 @@
 use std::path::{Path, PathBuf};
 
 use mocap_core::io::read_motion;
-use mocap_search::features::VALUE_NAMES;
+use mocap_search::VALUE_NAMES;
 use mocap_style::classify::clip_pose_statistics;
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};
 

@@ -22,7 +22,7 @@ use std::path::PathBuf;
 use mocap_core::io::read_motion;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_search::features::motion_features;
+use mocap_search::motion_features;
 use mocap_style::apply::{load_model, prepare_style, restyle, StageTimings};
 use mocap_style::convert::{windowed_mean, Asymmetry, ConvertOptions};
 use mocap_style::data::{labelled_paths, list_bvh, ClipFilter};

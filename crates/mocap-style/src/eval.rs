@@ -559,7 +559,7 @@ impl MotionMeasures {
 /// (`left_ankle.x`, `right_ankle.x`).
 pub fn sideways_ankle_values() -> [usize; 2] {
     ["left_ankle.x", "right_ankle.x"].map(|name| {
-        mocap_search::features::VALUE_NAMES
+        mocap_search::VALUE_NAMES
             .iter()
             .position(|n| *n == name)
             .expect("a pose value of mocap-search")
