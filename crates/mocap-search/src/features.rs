@@ -198,13 +198,7 @@ impl KeyJoints {
 pub fn motion_features(motion: &Motion) -> Result<FeatureSequence> {
     let joints = KeyJoints::detect(motion.skeleton())?;
     let poses = forward_kinematics(motion);
-    let parents: Vec<Option<usize>> = motion
-        .skeleton()
-        .joints()
-        .iter()
-        .map(|j| j.parent)
-        .collect();
-    pose_features(&poses, &joints, &parents, motion.fps())
+    pose_features(&poses, &joints, &motion.skeleton().parents(), motion.fps())
 }
 
 /// Body height `h` (see the module docs) from the first frame.
@@ -431,12 +425,7 @@ mod tests {
         let path = data.join("bandai/dataset-1/dataset-1_walk-left_normal_001.bvh");
         let motion = load_motion(&path).unwrap();
         let joints = KeyJoints::detect(motion.skeleton()).unwrap();
-        let parents: Vec<Option<usize>> = motion
-            .skeleton()
-            .joints()
-            .iter()
-            .map(|j| j.parent)
-            .collect();
+        let parents = motion.skeleton().parents();
         let poses = forward_kinematics(&motion);
         let base = pose_features(&poses, &joints, &parents, motion.fps()).unwrap();
         assert_eq!(base.dim, VALUE_COUNT);

@@ -78,7 +78,7 @@ impl ViewMotion {
         let skeleton = motion.skeleton();
         let joint_count = skeleton.joint_count();
         let mut names: Vec<String> = skeleton.joints().iter().map(|j| j.name.clone()).collect();
-        let mut parents: Vec<Option<usize>> = skeleton.joints().iter().map(|j| j.parent).collect();
+        let mut parents = skeleton.parents();
         for (j, joint) in skeleton.joints().iter().enumerate() {
             for k in 0..joint.end_sites.len() {
                 let suffix = if joint.end_sites.len() > 1 {
