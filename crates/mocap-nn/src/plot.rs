@@ -2,7 +2,10 @@
 
 use std::path::Path;
 
-use mocap_view::{plot_lines, LinePlot, Series};
+use mocap_view::{plot_lines, LinePlot};
+
+/// One curve of a loss plot (mocap-view's).
+pub use mocap_view::Series;
 
 use crate::train::{EpochRecord, History};
 use crate::Result;
@@ -51,8 +54,14 @@ pub fn history_series(history: &History, prefix: &str) -> Vec<Series> {
 /// Draws the training and validation curves of `history` into a PNG at
 /// `path` (written atomically).
 pub fn plot_history(path: &Path, history: &History, options: &PlotOptions) -> Result<()> {
+    plot_curves(path, &history_series(history, ""), options)
+}
+
+/// Draws `series` (several runs' curves) into a PNG at `path` (written
+/// atomically).
+pub fn plot_curves(path: &Path, series: &[Series], options: &PlotOptions) -> Result<()> {
     let plot = LinePlot {
-        series: history_series(history, ""),
+        series: series.to_vec(),
         log_y: options.log_y,
         size: (options.width, options.height),
         ..LinePlot::new(&options.title, &options.x_label, &options.y_label)

@@ -52,7 +52,8 @@ pub struct RenderOptions {
     /// Size of one panel of a filmstrip, or of the GIF, in pixels; `None`
     /// for 240 x 320 (filmstrip) or 480 x 400 per motion side by side (GIF).
     pub panel_size: Option<(u32, u32)>,
-    /// Filmstrip panels per row.
+    /// Filmstrip panels per row; with [`Layout::Rows`], the moments shown
+    /// when `every` is `None`.
     pub columns: usize,
     pub layout: Layout,
     /// Colour joints and bones by confidence (red 0 to green 1) where the
