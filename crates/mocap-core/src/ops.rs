@@ -497,7 +497,7 @@ const FIT_TOLERANCE_DEG: f32 = 3.0;
 /// bone). The choice does not change the mirrored positions, only how the
 /// mirrored rotation is split between a joint and its children, so it is
 /// made to keep local rotations natural. Among the reflections that fit the
-/// offsets within [`FIT_TOLERANCE_DEG`] of the best:
+/// offsets within 3 degrees of the best (`FIT_TOLERANCE_DEG`):
 /// - a joint without rotation channels takes its parent's reflection (so it
 ///   stays unrotated);
 /// - a joint on the midline takes the reflection across the local

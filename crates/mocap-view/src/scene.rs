@@ -355,8 +355,15 @@ impl Scene {
         Ok(Scene::new(motions))
     }
 
-    /// The scene as compact JSON for the web viewer (format in the module
-    /// documentation of [`crate::server`]).
+    /// The scene as compact JSON for the web viewer:
+    /// `{"version": 1, "up": "y", "unit": "m", "motions": [...]}` where each
+    /// motion has `label`, `source`, `colour` (`#rrggbb`), `frame_time` (s),
+    /// `frame_count`, `joint_count`, `names` and `parents` of its points
+    /// (joints, then end sites), `bones` (per point: draw the bone from its
+    /// parent), `shown` (per point: draw it), `metres_per_unit` (the factor
+    /// applied to the file's numbers), `positions` (metres, `[x, y, z]` of
+    /// every point of frame 0, then frame 1, ... flattened) and `confidence`
+    /// (`null`, or one value in 0..1 per joint per frame).
     pub fn to_json(&self) -> String {
         let motions = self
             .motions
