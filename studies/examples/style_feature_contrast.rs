@@ -19,7 +19,7 @@
 use std::path::{Path, PathBuf};
 
 use mocap_core::io::read_motion;
-use mocap_search::features::VALUE_NAMES;
+use mocap_search::VALUE_NAMES;
 use mocap_style::{clip_pose_statistics, labelled_paths, list_bvh, ClipFilter};
 
 /// Per clip: the mean, then the deviation, of every pose value over its frames.

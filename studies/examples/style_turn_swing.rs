@@ -22,7 +22,7 @@ use std::path::PathBuf;
 use mocap_core::io::read_motion;
 use mocap_core::Motion;
 use mocap_nn::device::DeviceChoice;
-use mocap_search::features::{motion_features, VALUE_NAMES};
+use mocap_search::{motion_features, VALUE_NAMES};
 use mocap_style::{
     gait_period, labelled_paths, list_bvh, load_model, prepare_style, restyle, windowed_mean,
     Asymmetry, ClipFilter, ConvertOptions, RigLayout, StageTimings,

@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use mocap_clean::training::{train, TrainOptions};
-use mocap_nn::plot::{plot_lines, PlotOptions, Series};
+use mocap_nn::plot::{plot_curves, PlotOptions, Series};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -59,7 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .into_iter()
                     .flatten()
                     .enumerate()
-                    .map(|(i, v)| ((i + 1) as f64, v.as_f64().unwrap_or(f64::NAN)))
+                    .map(|(i, v)| ((i + 1) as f32, v.as_f64().unwrap_or(f64::NAN) as f32))
                     .collect();
                 Series::new(
                     format!("{} seed {}", r["loss"].as_str().unwrap_or("?"), r["seed"]),
@@ -85,7 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .history
                 .epochs
                 .iter()
-                .map(|e| ((e.epoch + 1) as f64, e.valid_loss))
+                .map(|e| ((e.epoch + 1) as f32, e.valid_loss as f32))
                 .collect();
             series.push(Series::new(format!("{name} seed {seed}"), points));
             rows.push(serde_json::json!({
@@ -116,7 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 fn plot(out_dir: &std::path::Path, series: &[Series]) -> Result<(), Box<dyn std::error::Error>> {
-    plot_lines(
+    plot_curves(
         &out_dir.join("validation_curves.png"),
         series,
         &PlotOptions {

@@ -106,7 +106,14 @@ mod tests {
     /// and a capability's own, such as search's labels); their options are not
     /// a subcommand's own. Name a group here only when it is shared: the test
     /// checks that too.
-    const SHARED_GROUPS: &[&str] = &["DeviceArgs", "ReportArgs", "RestyleArgs", "TrainLoopArgs"];
+    const SHARED_GROUPS: &[&str] = &[
+        "DeviceArgs",
+        "ReportArgs",
+        "RestyleArgs",
+        "SearchForestArgs",
+        "SearchLabelArgs",
+        "TrainLoopArgs",
+    ];
     const MAX_OWN_OPTIONS: usize = 15;
 
     /// Every rule of `commands::args`, on every subcommand; the failure lists

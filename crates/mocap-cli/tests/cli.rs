@@ -1,7 +1,7 @@
 //! The `mocap` command as a user runs it: outputs, exit codes and messages.
 
 use mocap_testdata::shared_data;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use mocap_core::io::asf_amc::read_asf_amc;
@@ -15,15 +15,8 @@ fn mocap(args: &[&str]) -> Output {
         .expect("the mocap binary runs")
 }
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
 fn sample() -> String {
-    repo()
-        .join("samples/dataset-1_walk_normal_001.bvh")
-        .display()
-        .to_string()
+    mocap_testdata::sample_walk().display().to_string()
 }
 
 fn stderr(out: &Output) -> String {

@@ -7,14 +7,14 @@ use std::process::Command;
 use serde_json::Value;
 
 fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    mocap_testdata::repo_root()
 }
 
-/// Runs `mocap demo --out DIR --json ARGS...` and returns the parsed report.
+/// Runs `mocap demo -o DIR --json ARGS...` and returns the parsed report.
 fn demo(out: &Path, extra: &[&str]) -> Value {
     let output = Command::new(env!("CARGO_BIN_EXE_mocap"))
         .current_dir(workspace())
-        .args(["demo", "--json", "--out"])
+        .args(["demo", "--json", "--output"])
         .arg(out)
         .args(extra)
         .output()

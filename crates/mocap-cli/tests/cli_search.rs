@@ -1,6 +1,6 @@
 //! `mocap search` end to end on a small real library.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn mocap(args: &[&str]) -> Output {
@@ -11,14 +11,7 @@ fn mocap(args: &[&str]) -> Output {
 }
 
 fn bandai() -> Option<PathBuf> {
-    let dir = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
-        .join("bandai/dataset-2");
-    dir.is_dir().then_some(dir).or_else(|| {
-        eprintln!("note: Bandai data not found, skipping");
-        None
-    })
+    mocap_testdata::shared("bandai/dataset-2")
 }
 
 #[test]
@@ -93,7 +86,7 @@ fn index_then_query_finds_the_category() {
 }
 
 #[test]
-fn eval_draws_a_confusion_matrix_per_method() {
+fn eval_prints_json_writes_markdown_and_draws_a_confusion_matrix_per_method() {
     let Some(data) = bandai() else { return };
     let dir = tempfile::tempdir().unwrap();
     let mut args: Vec<String> = vec!["search".into(), "eval".into()];
@@ -107,8 +100,11 @@ fn eval_draws_a_confusion_matrix_per_method() {
         }
     }
     let plots = dir.path().join("plots");
+    let markdown = dir.path().join("report.md");
     args.extend(
         [
+            "--markdown",
+            markdown.to_str().unwrap(),
             "--labels-from-name",
             "bandai-content",
             "--trees",
@@ -145,6 +141,9 @@ fn eval_draws_a_confusion_matrix_per_method() {
         })
         .count();
     assert_eq!(drawn, 2 * methods.len(), "a PNG and an SVG per method");
+    // --json prints JSON; --markdown FILE writes the tables as well.
+    let tables = std::fs::read_to_string(&markdown).unwrap();
+    assert!(tables.contains("| forest |"), "{tables}");
 }
 
 #[test]
@@ -154,9 +153,9 @@ fn a_query_on_an_index_moved_without_its_clips_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let moved = dir.path().join("x/y/library.idx");
     std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let repo = mocap_testdata::repo_root();
     std::fs::copy(repo.join("models/search-bandai-content.idx"), &moved).unwrap();
-    let sample = repo.join("samples/dataset-1_walk_normal_001.bvh");
+    let sample = mocap_testdata::sample_walk();
     let out = mocap(&[
         "search",
         "query",

@@ -2,14 +2,10 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::path::Path;
 use std::process::{Command, Stdio};
 
 fn sample() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../samples/dataset-1_walk_normal_001.bvh")
-        .display()
-        .to_string()
+    mocap_testdata::sample_walk().display().to_string()
 }
 
 #[test]

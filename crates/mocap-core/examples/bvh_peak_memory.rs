@@ -9,8 +9,8 @@
 //! for one large file, e.g. `bench/bvhio_parse.py` on the same folder).
 //! Without either, writes a synthetic take of about
 //! `--mb` megabytes (default 300) to a temporary file by repeating the frame
-//! lines of the longest Bandai take in `shared/data/bandai/dataset-1` (found
-//! as in the tests: `MOCAP_SHARED_DATA` or `<workspace>/../shared/data`),
+//! lines of the longest Bandai take in `bandai/dataset-1` of the shared data
+//! (found as in the tests, by `mocap_testdata::shared`),
 //! then parses that. Prints the file size, the parse time, the throughput and
 //! the peak resident memory of the parse (`VmHWM` from `/proc/self/status`,
 //! reset before the parse through `/proc/self/clear_refs` where the kernel
@@ -64,7 +64,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let files = if path.is_dir() {
-        bvh_files_in(&path)?
+        mocap_testdata::bvh_files(&path)
     } else {
         vec![path.clone()]
     };
@@ -103,37 +103,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// The `.bvh` files of a folder, sorted.
-fn bvh_files_in(dir: &Path) -> Result<Vec<PathBuf>, Box<dyn std::error::Error>> {
-    let mut files = Vec::new();
-    for entry in std::fs::read_dir(dir)? {
-        let path = entry?.path();
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("bvh"))
-        {
-            files.push(path);
-        }
-    }
-    files.sort();
-    Ok(files)
-}
-
 /// The dataset-1 take with the most bytes.
 fn longest_bandai_take() -> Result<PathBuf, Box<dyn std::error::Error>> {
-    let data = match std::env::var_os("MOCAP_SHARED_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
-    };
-    let dir = data.join("bandai/dataset-1");
+    let dir = mocap_testdata::shared("bandai/dataset-1").ok_or("no shared data")?;
     let mut best: Option<(u64, PathBuf)> = None;
-    for entry in std::fs::read_dir(&dir).map_err(|e| format!("{}: {e}", dir.display()))? {
-        let path = entry?.path();
-        if path.extension().is_some_and(|e| e == "bvh") {
-            let len = std::fs::metadata(&path)?.len();
-            if best.as_ref().is_none_or(|(l, _)| len > *l) {
-                best = Some((len, path));
-            }
+    for path in mocap_testdata::bvh_files(&dir) {
+        let len = std::fs::metadata(&path)?.len();
+        if best.as_ref().is_none_or(|(l, _)| len > *l) {
+            best = Some((len, path));
         }
     }
     Ok(best.ok_or("no BVH file in bandai/dataset-1")?.1)

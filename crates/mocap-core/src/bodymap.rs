@@ -60,7 +60,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::RwLock;
 
-use crate::error::{Error, Location, ParseError, Result};
+use crate::error::{Error, ParseError, Result};
 use crate::skeleton::Skeleton;
 
 /// Left or right side of the body.
@@ -864,14 +864,7 @@ impl RigFile {
                 Some(span) => line_column(text, span.start),
                 None => (1, 1),
             };
-            ParseError {
-                location: Location {
-                    path: path.to_path_buf(),
-                    line,
-                    column,
-                },
-                message: format!("rig file: {}", e.message()),
-            }
+            ParseError::new(path, line, column, format!("rig file: {}", e.message()))
         })?;
         if let Some(key) = file.parts.keys().find(|k| BodyPart::from_key(k).is_none()) {
             let keys: Vec<&str> = BodyPart::ALL.iter().map(|p| p.key()).collect();

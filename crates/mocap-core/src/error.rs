@@ -29,6 +29,25 @@ pub struct ParseError {
     pub message: String,
 }
 
+impl ParseError {
+    /// What is wrong at `line` and `column` (1-based) of the file at `path`.
+    pub fn new(
+        path: impl Into<PathBuf>,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> ParseError {
+        ParseError {
+            location: Location {
+                path: path.into(),
+                line,
+                column,
+            },
+            message: message.into(),
+        }
+    }
+}
+
 /// Any error of the core crate.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -48,6 +67,17 @@ pub enum Error {
 }
 
 impl Error {
+    /// A [`ParseError`] at `line` and `column` (1-based) of the file at
+    /// `path`.
+    pub fn parse(
+        path: impl Into<PathBuf>,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Parse(ParseError::new(path, line, column, message))
+    }
+
     pub fn io(path: impl Into<PathBuf>, error: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),

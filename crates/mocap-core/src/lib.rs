@@ -9,10 +9,14 @@
 //! - [`ops`]: resample, trim, mirror, scale;
 //! - [`retarget`]: a motion played by another rig of the same body map;
 //! - [`metrics`]: position and rotation errors, bone-length statistics;
-//! - [`io`]: BVH and ASF/AMC files, and atomic writes.
+//! - [`io`]: BVH and ASF/AMC files, and atomic writes;
+//! - [`info`] and [`convert`]: what `mocap info` reports and what `mocap
+//!   convert` does, for any front end.
 
 pub mod bodymap;
+pub mod convert;
 pub mod error;
+pub mod info;
 pub mod io;
 pub mod kinematics;
 pub mod metrics;

@@ -15,6 +15,61 @@ use crate::motion::Motion;
 use crate::rotation::{angle_between, slerp, Axis, Mat3, Quat, Vec3};
 use crate::skeleton::{Joint, Skeleton};
 
+/// Frames of a take, as written on the command line: `A..B` (frames `A` up
+/// to, not including, `B`, counted from 0), `A..` (to the end) or `..B`
+/// (from the start). Parse with `str::parse`; [`FrameRange::resolve`] gives
+/// the frames of a take of known length.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FrameRange {
+    pub start: Option<usize>,
+    pub end: Option<usize>,
+}
+
+impl FrameRange {
+    /// The frames `range`.
+    pub fn new(range: Range<usize>) -> FrameRange {
+        FrameRange {
+            start: Some(range.start),
+            end: Some(range.end),
+        }
+    }
+
+    /// The frames of a timeline of `frame_count` frames.
+    pub fn resolve(&self, frame_count: usize) -> Range<usize> {
+        self.start.unwrap_or(0)..self.end.unwrap_or(frame_count)
+    }
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<FrameRange> {
+        let bad = || {
+            Error::Invalid(format!(
+                "frame range `{text}`: expected A..B (frames A up to, not including, B, counted from 0), A.. or ..B"
+            ))
+        };
+        let (a, b) = text.split_once("..").ok_or_else(bad)?;
+        let number = |s: &str| -> Result<Option<usize>> {
+            let s = s.trim();
+            if s.is_empty() {
+                Ok(None)
+            } else {
+                s.parse().map(Some).map_err(|_| bad())
+            }
+        };
+        let (start, end) = (number(a)?, number(b)?);
+        if let (Some(a), Some(b)) = (start, end) {
+            if a >= b {
+                return Err(Error::Invalid(format!(
+                    "frame range `{text}` is empty: the first frame must come before the end"
+                )));
+            }
+        }
+        Ok(FrameRange { start, end })
+    }
+}
+
 /// Samples closer than this to a source frame (in frames) copy that frame's
 /// values unchanged instead of interpolating. Files round their frame time
 /// (Bandai writes `0.0333333` for 1/30 s), so a sample meant to fall on a
@@ -442,7 +497,7 @@ const FIT_TOLERANCE_DEG: f32 = 3.0;
 /// bone). The choice does not change the mirrored positions, only how the
 /// mirrored rotation is split between a joint and its children, so it is
 /// made to keep local rotations natural. Among the reflections that fit the
-/// offsets within [`FIT_TOLERANCE_DEG`] of the best:
+/// offsets within 3 degrees of the best (`FIT_TOLERANCE_DEG`):
 /// - a joint without rotation channels takes its parent's reflection (so it
 ///   stays unrotated);
 /// - a joint on the midline takes the reflection across the local

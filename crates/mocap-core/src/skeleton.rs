@@ -219,6 +219,11 @@ impl Skeleton {
         self.joints.len()
     }
 
+    /// The parent of every joint (`None` for roots), in joint order.
+    pub fn parents(&self) -> Vec<Option<usize>> {
+        self.joints.iter().map(|j| j.parent).collect()
+    }
+
     /// Number of channel values in one frame.
     pub fn channel_count(&self) -> usize {
         self.channel_count

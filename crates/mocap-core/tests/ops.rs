@@ -324,11 +324,11 @@ fn turn_turns_every_global_position_and_keeps_the_rotations_below_the_root() {
 
 #[test]
 fn mirror_splits_rotations_the_same_way_whichever_way_the_performer_faces() {
-    // A performer facing 45 degrees off the world axes used to get the
-    // wrong local planes for the joints on the midline (judged against the
-    // nearest world axis): the right positions, but a neck twisted half a
-    // turn and its children turned back, which a denoiser trained on real
-    // takes reads as nonsense.
+    // Judging the midline joints' local planes against the nearest world
+    // axis would fail a performer facing 45 degrees off the world axes: the
+    // right positions, but a neck twisted half a turn and its children
+    // turned back, which a denoiser trained on real takes reads as
+    // nonsense.
     for degrees in [0.0f32, 30.0, 45.0, 50.0, 60.0, 90.0, 135.0, 200.0, 315.0] {
         let m = bundled_walk_turned(degrees);
         let s = m.skeleton();

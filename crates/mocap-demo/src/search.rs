@@ -6,7 +6,7 @@
 //! (walk, run, wave...; see `docs/demo.md` for the command). The sample is
 //! from dataset-1, so it is not in the library.
 
-use mocap_search::{load_features, Index, Ranking};
+use mocap_search::{Index, Ranking};
 use mocap_view::{plot_bars, BarPlot, BarSeries};
 
 use crate::{require_file, StageContext, StageReport, StageResult};
@@ -18,13 +18,12 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     let options = context.options;
     require_file(&options.search_index, "the search library index")?;
     let index = Index::load(&options.search_index)?;
-    let (features, _fps) = load_features(&options.sample)?;
+    let answer = index.query_file(&options.sample, TOP, Ranking::Histogram)?;
     let name = options
         .sample
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let answer = index.query(&name, &features, TOP, Ranking::Histogram);
     report.fact("predicted", answer.predicted.clone());
     report.number(
         "probability",

@@ -330,11 +330,7 @@ pub fn save_epoch<M: Module>(
         },
     )?;
     save_weights(out, inference_model, header)?;
-    crate::plot::plot_lines(
-        plot,
-        &crate::plot::history_series(history, ""),
-        plot_options,
-    )
+    crate::plot::plot_history(plot, history, plot_options)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //!   trained on; resumable training state;
 //! - [`train`]: an epoch loop with a progress bar (hidden when stderr is not a
 //!   terminal), loss history, and one Adam step;
-//! - [`plot`]: loss curves as PNG;
+//! - [`plot`]: loss curves as PNG (drawn by mocap-view);
 //! - [`kinematics`]: forward kinematics on tensors, for losses on joint
 //!   positions.
 //!
@@ -44,12 +44,6 @@ pub enum NnError {
     /// The training loss stopped being a number: training diverged.
     #[error("the training loss became {loss} at epoch {epoch}: lower the learning rate")]
     Diverged { loss: f64, epoch: usize },
-    /// Drawing a plot failed.
-    #[error("{path}: cannot draw the plot: {message}")]
-    Plot {
-        path: std::path::PathBuf,
-        message: String,
-    },
 }
 
 pub type Result<T, E = NnError> = std::result::Result<T, E>;

@@ -18,13 +18,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use mocap_search::features::VALUE_COUNT;
-use mocap_search::forest::{argmax, Forest, Samples};
-use mocap_search::index::{LibraryClip, Ranking};
-use mocap_search::intervals::IntervalLayout;
 use mocap_search::{
-    build_index, load_clips, load_features, motion_files, Index, IndexConfig, LabelRule,
-    NamePattern,
+    argmax, build_index, load_clips, load_features, motion_files, Forest, Index, IndexConfig,
+    IntervalLayout, LabelRule, LibraryClip, NamePattern, Ranking, Samples, VALUE_COUNT,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

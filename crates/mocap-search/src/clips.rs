@@ -33,51 +33,7 @@ impl Clip {
 /// recursively for `.bvh` and `.amc` files. Sorted by path, so that every
 /// run sees the clips in the same order.
 pub fn motion_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
-        let entries = std::fs::read_dir(dir).map_err(|e| SearchError::Io {
-            path: dir.to_path_buf(),
-            error: e,
-        })?;
-        for entry in entries {
-            let entry = entry.map_err(|e| SearchError::Io {
-                path: dir.to_path_buf(),
-                error: e,
-            })?;
-            let path = entry.path();
-            if path.is_dir() {
-                walk(&path, out)?;
-            } else if is_motion_file(&path) {
-                out.push(path);
-            }
-        }
-        Ok(())
-    }
-    let mut files = Vec::new();
-    for input in inputs {
-        if input.is_dir() {
-            walk(input, &mut files)?;
-        } else if input.is_file() {
-            files.push(input.clone());
-        } else {
-            return Err(SearchError::Io {
-                path: input.clone(),
-                error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or folder"),
-            });
-        }
-    }
-    files.sort();
-    files.dedup();
-    Ok(files)
-}
-
-fn is_motion_file(path: &Path) -> bool {
-    matches!(
-        path.extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref(),
-        Some("bvh") | Some("amc")
-    )
+    Ok(mocap_core::io::find_files(inputs, &["bvh", "amc"])?)
 }
 
 /// Reads a motion file: BVH, or AMC with the skeleton from the ASF file
@@ -137,7 +93,7 @@ pub fn load_clips(paths: &[PathBuf], rule: &LabelRule, progress: bool) -> Result
 
 /// A progress bar on standard error, drawn only when it is a terminal (and
 /// `show` is set), so that logs and pipes stay clean.
-pub fn progress_bar(len: usize, message: &str, show: bool) -> ProgressBar {
+pub(crate) fn progress_bar(len: usize, message: &str, show: bool) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }

@@ -16,7 +16,7 @@ use crate::intervals::FeatureSequence;
 
 /// DTW distance between two feature sequences of the same dimension,
 /// normalised by the sum of their lengths. Infinite when either is empty.
-pub fn dtw_distance(a: &FeatureSequence, b: &FeatureSequence) -> f32 {
+pub(crate) fn dtw_distance(a: &FeatureSequence, b: &FeatureSequence) -> f32 {
     assert_eq!(a.dim, b.dim, "DTW needs sequences of the same features");
     let (n, m) = (a.frame_count(), b.frame_count());
     if n == 0 || m == 0 {
@@ -42,7 +42,7 @@ pub fn dtw_distance(a: &FeatureSequence, b: &FeatureSequence) -> f32 {
 /// One match of [`subsequence_dtw`]: frames `[start, end)` of the long
 /// sequence and the normalised cost of the alignment.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SubsequenceMatch {
+pub(crate) struct SubsequenceMatch {
     pub start: usize,
     pub end: usize,
     pub cost: f32,
@@ -64,7 +64,7 @@ pub struct SubsequenceMatch {
 /// and each end `j` scored by `D(n-1, j)` divided by the number of cells on
 /// its path. Returns up to `top` matches, best first, each overlapping an
 /// earlier one by at most `max_overlap` (intersection over union).
-pub fn subsequence_dtw(
+pub(crate) fn subsequence_dtw(
     query: &FeatureSequence,
     long: &FeatureSequence,
     top: usize,
@@ -161,7 +161,7 @@ pub fn subsequence_dtw(
 }
 
 /// Euclidean distance between two vectors of the same length.
-pub fn euclidean(a: &[f32], b: &[f32]) -> f32 {
+pub(crate) fn euclidean(a: &[f32], b: &[f32]) -> f32 {
     a.iter()
         .zip(b)
         .map(|(x, y)| (x - y) * (x - y))

@@ -25,6 +25,7 @@
 //!   and the returned time ranges are scored against the joined clips.
 
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use rand::rngs::Xoshiro256PlusPlus;
@@ -33,13 +34,14 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::clips::{progress_bar, Clip};
+use crate::clips::{load_clips, motion_files, progress_bar, Clip};
 use crate::dtw::{dtw_distance, euclidean};
 use crate::error::{Result, SearchError};
 use crate::features::VALUE_COUNT;
 use crate::forest::{argmax, Forest, Samples, Tree};
 use crate::index::{build_index, nearest, value_statistics, IndexConfig, Ranking};
 use crate::intervals::{FeatureSequence, IntervalLayout};
+use crate::labels::LabelRule;
 use crate::scores::{average_precision, precision_at, ClassScores, ConfusionMatrix};
 use crate::take::{overlap, search_take, TakeMethod, TakeSearchConfig};
 
@@ -231,7 +233,7 @@ pub struct EvalReport {
 
 /// Training and test clips of one fold, as indices into the clip list.
 #[derive(Debug, Clone)]
-pub struct Fold {
+pub(crate) struct Fold {
     pub train: Vec<usize>,
     pub test: Vec<usize>,
 }
@@ -251,6 +253,33 @@ struct Prepared {
 impl Prepared {
     fn row(&self, k: usize) -> &[f32] {
         &self.rows[k * self.dim..(k + 1) * self.dim]
+    }
+}
+
+/// `mocap search eval`: reads the clips of `inputs` (files, or folders
+/// searched for `.bvh` and `.amc`), labels them by `rule` and evaluates:
+/// split by `config.split` ([`evaluate`]), or, when `test` names files or
+/// folders, trained on `inputs` and tested on those
+/// ([`evaluate_train_test`]). `rule_name` names the rule and `dataset` the
+/// data in the report (default: the inputs joined by ` + `).
+pub fn evaluate_files(
+    inputs: &[PathBuf],
+    test: &[PathBuf],
+    rule: &LabelRule,
+    rule_name: &str,
+    dataset: Option<&str>,
+    config: &EvalConfig,
+) -> Result<EvalReport> {
+    let dataset = dataset.map(str::to_string).unwrap_or_else(|| {
+        let names: Vec<String> = inputs.iter().map(|d| d.display().to_string()).collect();
+        names.join(" + ")
+    });
+    let clips = load_clips(&motion_files(inputs)?, rule, config.progress)?;
+    if test.is_empty() {
+        evaluate(&clips, &dataset, rule_name, config)
+    } else {
+        let test = load_clips(&motion_files(test)?, rule, config.progress)?;
+        evaluate_train_test(&clips, &test, &dataset, rule_name, config)
     }
 }
 
@@ -358,7 +387,12 @@ fn label_indices(clips: &[Clip], classes: &[String]) -> Vec<u32> {
 /// class starts where the previous class's ended, so that small classes do
 /// not all land in the first folds. `labels[i]` is clip `i`'s class, below
 /// `classes`; folds with no test or no training clip are left out.
-pub fn stratified_folds(labels: &[u32], classes: usize, k: usize, seed: u64) -> Result<Vec<Fold>> {
+pub(crate) fn stratified_folds(
+    labels: &[u32],
+    classes: usize,
+    k: usize,
+    seed: u64,
+) -> Result<Vec<Fold>> {
     if k < 2 {
         return Err(SearchError::Invalid(format!(
             "cross-validation needs at least 2 folds, got {k}"

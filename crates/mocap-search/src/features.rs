@@ -37,21 +37,20 @@
 //! The velocities (45-52) carry what a single pose cannot: walking forward,
 //! backward, sideways or in a turn differ mostly in how the pelvis moves.
 //!
-//! Values 56-75 were added (feature version 2) for the arm gestures of
-//! Bandai dataset-1 (bye, byebye, guide, bow), which the first 56 values
-//! confused most: the direction a wrist moves (a wave goes side to side, a
-//! guiding gesture out and back), where the forearm points, the hand's
-//! position measured from its own shoulder rather than the pelvis (so a
-//! bent or leaning trunk moves it less) and how jerky the hand moves (a
-//! wave reverses direction several times a second). On dataset-1 content,
-//! 5-fold by take, mean over fold seeds 1-20 (`bench/search/seeds.sh`),
-//! they raised the macro F over the 10 classes with 15 or more clips from
-//! 0.840 to 0.851 and over all 13 classes from 0.700 to 0.714 (dataset-1
-//! styles 0.525 to 0.544; dataset-2 unchanged at 0.99+; see
+//! Values 56-75 (feature version 2) serve the arm gestures of Bandai
+//! dataset-1 (bye, byebye, guide, bow), which the first 56 values confuse
+//! most: the direction a wrist moves (a wave goes side to side, a guiding
+//! gesture out and back), where the forearm points, the hand's position
+//! measured from its own shoulder rather than the pelvis (so a bent or
+//! leaning trunk moves it less) and how jerky the hand moves (a wave
+//! reverses direction several times a second). On dataset-1 content,
+//! 5-fold by take, mean over fold seeds 1-20 (`bench/search/seeds.sh`), the
+//! macro F over the 10 classes with 15 or more clips is 0.851 with them and
+//! 0.840 without, over all 13 classes 0.714 and 0.700 (dataset-1 styles
+//! 0.544 and 0.525; dataset-2 0.99+ either way; see
 //! `bench/results/search.md`). Signed ankle velocities, the horizontal
-//! pelvis speed and the ankles' heights above the floor were tried as well
-//! and gave nothing beyond the spread between seeds, so they are not
-//! included.
+//! pelvis speed and the ankles' heights above the floor give nothing beyond
+//! the spread between seeds, so they are not included.
 
 use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::rotation::Vec3;
@@ -65,7 +64,7 @@ pub const VALUE_COUNT: usize = 76;
 
 /// Version of the feature definition, stored in every index: change it when
 /// the values above change, so that old index files are reported stale.
-pub const FEATURE_VERSION: u32 = 2;
+pub(crate) const FEATURE_VERSION: u32 = 2;
 
 /// Names of the 76 values, in order.
 pub const VALUE_NAMES: [&str; VALUE_COUNT] = [
@@ -152,7 +151,7 @@ const UP: Vec3 = Vec3::Y;
 
 /// The joints the features are made of, as joint indices of one skeleton.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct KeyJoints {
+pub(crate) struct KeyJoints {
     pub pelvis: usize,
     pub neck: usize,
     pub head: usize,
@@ -199,17 +198,15 @@ impl KeyJoints {
 pub fn motion_features(motion: &Motion) -> Result<FeatureSequence> {
     let joints = KeyJoints::detect(motion.skeleton())?;
     let poses = forward_kinematics(motion);
-    let parents: Vec<Option<usize>> = motion
-        .skeleton()
-        .joints()
-        .iter()
-        .map(|j| j.parent)
-        .collect();
-    pose_features(&poses, &joints, &parents, motion.fps())
+    pose_features(&poses, &joints, &motion.skeleton().parents(), motion.fps())
 }
 
 /// Body height `h` (see the module docs) from the first frame.
-pub fn body_height(poses: &GlobalPoses, joints: &KeyJoints, parents: &[Option<usize>]) -> f32 {
+pub(crate) fn body_height(
+    poses: &GlobalPoses,
+    joints: &KeyJoints,
+    parents: &[Option<usize>],
+) -> f32 {
     // Length of the bone chain from `from` up to its ancestor `to`.
     let chain = |from: usize, to: usize| -> f32 {
         let mut length = 0.0;
@@ -281,7 +278,7 @@ fn second_difference_frames(f: usize, frames: usize) -> Option<(usize, usize, us
 /// The 76 values of every frame of `poses` (see the module docs).
 /// `parents` gives each joint's parent (for the body height) and `fps`
 /// turns frame differences into velocities per second.
-pub fn pose_features(
+pub(crate) fn pose_features(
     poses: &GlobalPoses,
     j: &KeyJoints,
     parents: &[Option<usize>],
@@ -402,4 +399,93 @@ pub fn pose_features(
         dim: VALUE_COUNT,
         values,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use mocap_core::rotation::{Quat, Vec3};
+    use mocap_core::{forward_kinematics, GlobalPoses};
+    use mocap_testdata::shared_data;
+
+    use super::*;
+    use crate::clips::{load_features, load_motion};
+
+    /// Moves, turns and scales the global poses of a whole take.
+    fn transform(poses: &GlobalPoses, turn: Quat, shift: Vec3, scale: f32) -> GlobalPoses {
+        let mut out = poses.clone();
+        for p in &mut out.positions {
+            *p = turn * (*p * scale) + shift;
+        }
+        out
+    }
+
+    #[test]
+    fn features_do_not_depend_on_place_heading_or_body_size() {
+        let Some(data) = shared_data() else { return };
+        let path = data.join("bandai/dataset-1/dataset-1_walk-left_normal_001.bvh");
+        let motion = load_motion(&path).unwrap();
+        let joints = KeyJoints::detect(motion.skeleton()).unwrap();
+        let parents = motion.skeleton().parents();
+        let poses = forward_kinematics(&motion);
+        let base = pose_features(&poses, &joints, &parents, motion.fps()).unwrap();
+        assert_eq!(base.dim, VALUE_COUNT);
+        assert_eq!(base.frame_count(), motion.frame_count());
+        let moved = transform(
+            &poses,
+            Quat::from_rotation_y(2.1),
+            Vec3::new(300.0, 0.0, -120.0),
+            0.62,
+        );
+        let other = pose_features(&moved, &joints, &parents, motion.fps()).unwrap();
+        // Relative to the value's size where it exceeds 1: the wrist
+        // accelerations (values 74-75) are second differences of positions
+        // times fps², so they carry the positions' f32 rounding times 900.
+        let worst = base
+            .values
+            .iter()
+            .zip(&other.values)
+            .map(|(a, b)| (a - b).abs() / a.abs().max(1.0))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-3, "largest change {worst}");
+        // Bandai's walk-left travels diagonally forward and to the left with
+        // the body facing forward: the pelvis moves along +x (the body's left)
+        // and +z (forward). Walking right mirrors that; a turn to the left
+        // turns the facing direction counter-clockwise seen from above
+        // (positive turning speed).
+        let mean_of = |features: &FeatureSequence, i: usize| {
+            let n = features.frame_count();
+            (0..n).map(|f| features.frame(f)[i]).sum::<f32>() / n as f32
+        };
+        let mean = |i: usize| mean_of(&base, i);
+        let (vx, vz) = (mean(45), mean(47));
+        assert!(
+            vx > 0.15 && vz > 0.5,
+            "walk-left: pelvis velocity x {vx}, z {vz}"
+        );
+        let features = |file: &str| load_features(&data.join("bandai").join(file)).unwrap().0;
+        // (take, value, bound): walking right and back, turning left and
+        // right; a positive bound is a floor, a negative one a ceiling.
+        for (file, value, bound) in [
+            ("dataset-1/dataset-1_walk-right_normal_001.bvh", 45, -0.15),
+            ("dataset-1/dataset-1_walk-back_normal_001.bvh", 47, -0.5),
+            ("dataset-2/dataset-2_walk-turn-left_normal_001.bvh", 48, 0.3),
+            (
+                "dataset-2/dataset-2_walk-turn-right_normal_001.bvh",
+                48,
+                -0.3,
+            ),
+        ] {
+            let mean = mean_of(&features(file), value);
+            let beyond = if bound > 0.0 {
+                mean > bound
+            } else {
+                mean < bound
+            };
+            assert!(beyond, "{file}: value {value} has mean {mean}");
+        }
+        // Standing height: the pelvis is about half a body height above the
+        // floor.
+        let pelvis = mean(27);
+        assert!(pelvis > 0.35 && pelvis < 0.65, "pelvis height {pelvis}");
+    }
 }

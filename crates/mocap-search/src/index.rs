@@ -28,23 +28,23 @@
 //! index file is in (absolute where no relative path exists), and
 //! [`Index::load`] turns them back into absolute paths; so an index and its
 //! clips can be moved together, and queries name the right files whatever
-//! the working directory. (Format version 1 stored the paths as given on the
-//! command line, which broke when the working directory changed.)
+//! the working directory.
 
 use std::path::{Component, Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::clips::{progress_bar, Clip};
+use crate::clips::{load_clips, load_features, motion_files, progress_bar, Clip};
 use crate::dtw::euclidean;
 use crate::error::{Result, SearchError};
 use crate::features::{FEATURE_VERSION, VALUE_COUNT};
 use crate::forest::{argmax, Forest, ForestConfig, Samples};
 use crate::intervals::{FeatureSequence, IntervalLayout};
+use crate::labels::LabelRule;
 
 const MAGIC: &[u8; 8] = b"MOCAPIDX";
 /// Version of the index file layout; change it when `Index` changes.
-pub const FORMAT_VERSION: u32 = 2;
+pub(crate) const FORMAT_VERSION: u32 = 2;
 const HEADER_LEN: usize = 28;
 
 /// How to build an index.
@@ -142,10 +142,8 @@ impl std::str::FromStr for Ranking {
 
 /// What the index computes for a query clip.
 #[derive(Debug, Clone)]
-pub struct QueryVector {
+pub(crate) struct QueryVector {
     pub resampled: FeatureSequence,
-    /// All interval means (the forest's input row).
-    pub row: Vec<f32>,
     pub histogram: Vec<f32>,
     pub leaves: Vec<u32>,
 }
@@ -231,6 +229,21 @@ impl QueryReport {
     }
 }
 
+/// `mocap search index`: reads the clips of `inputs` (files, or folders
+/// searched for `.bvh` and `.amc`), labels them by `rule` and builds the
+/// index ([`build_index`]). `rule_name` names the rule in reports;
+/// `progress` shows progress bars on standard error.
+pub fn index_files(
+    inputs: &[PathBuf],
+    rule: &LabelRule,
+    rule_name: &str,
+    config: &IndexConfig,
+    progress: bool,
+) -> Result<Index> {
+    let clips = load_clips(&motion_files(inputs)?, rule, progress)?;
+    build_index(&clips, rule_name, config, progress)
+}
+
 /// Builds the forest and the library from labelled clips.
 ///
 /// Every clip is resampled to `config.frames` frames and turned into its
@@ -311,7 +324,7 @@ pub fn build_index(
 
 /// Mean and standard deviation of every value over all frames of the
 /// resampled clips (a zero deviation becomes 1).
-pub fn value_statistics(clips: &[FeatureSequence]) -> (Vec<f32>, Vec<f32>) {
+pub(crate) fn value_statistics(clips: &[FeatureSequence]) -> (Vec<f32>, Vec<f32>) {
     let dim = VALUE_COUNT;
     let mut sum = vec![0.0f64; dim];
     let mut sum_sq = vec![0.0f64; dim];
@@ -350,18 +363,17 @@ impl Index {
     }
 
     /// Resamples a query's per-frame features and runs it through the forest.
-    pub fn describe(&self, features: &FeatureSequence) -> QueryVector {
+    pub(crate) fn describe(&self, features: &FeatureSequence) -> QueryVector {
         let resampled = features.resample(self.config.frames);
         self.describe_resampled(resampled)
     }
 
     /// Like [`Index::describe`] for a clip already resampled to `frames`.
-    pub fn describe_resampled(&self, resampled: FeatureSequence) -> QueryVector {
+    pub(crate) fn describe_resampled(&self, resampled: FeatureSequence) -> QueryVector {
         let row = self.layout().interval_means(&resampled);
         QueryVector {
             histogram: self.forest.predict(&row),
             leaves: self.forest.leaves(&row),
-            row,
             resampled,
         }
     }
@@ -379,7 +391,7 @@ impl Index {
     }
 
     /// Distance between two described clips under `ranking`.
-    pub fn pair_distance(&self, a: &QueryVector, b: &QueryVector, ranking: Ranking) -> f32 {
+    pub(crate) fn pair_distance(&self, a: &QueryVector, b: &QueryVector, ranking: Ranking) -> f32 {
         match ranking {
             Ranking::Histogram => euclidean(&a.histogram, &b.histogram),
             Ranking::Proximity => 1.0 - self.forest.path_proximity(&a.leaves, &b.leaves),
@@ -394,7 +406,7 @@ impl Index {
     }
 
     /// Distance from the query to every library clip under `ranking`.
-    pub fn distances(&self, query: &QueryVector, ranking: Ranking) -> Vec<f32> {
+    pub(crate) fn distances(&self, query: &QueryVector, ranking: Ranking) -> Vec<f32> {
         match ranking {
             Ranking::Histogram => self
                 .clips
@@ -415,6 +427,13 @@ impl Index {
                     .collect()
             }
         }
+    }
+
+    /// `mocap search query`: reads the clip at `path` (BVH, or AMC next to
+    /// its ASF), classifies it and ranks the library (best `top` clips).
+    pub fn query_file(&self, path: &Path, top: usize, ranking: Ranking) -> Result<QueryReport> {
+        let (features, _fps) = load_features(path)?;
+        Ok(self.query(&path.display().to_string(), &features, top, ranking))
     }
 
     /// Classifies a query and ranks the library (best `top` clips).
@@ -593,7 +612,7 @@ impl Index {
 }
 
 /// Indices of the `top` smallest distances, nearest first (ties by index).
-pub fn nearest(distances: &[f32], top: usize) -> Vec<usize> {
+pub(crate) fn nearest(distances: &[f32], top: usize) -> Vec<usize> {
     let mut order: Vec<usize> = (0..distances.len()).collect();
     let by = |a: &usize, b: &usize| distances[*a].total_cmp(&distances[*b]).then(a.cmp(b));
     let top = top.min(order.len());

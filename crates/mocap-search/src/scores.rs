@@ -121,7 +121,7 @@ fn ratio(a: u32, b: u32) -> f64 {
 /// relevant: the mean, over the relevant items, of the precision of the list
 /// cut just after that item. `total_relevant` counts every relevant item in
 /// the library (a relevant item missing from the list counts as precision 0).
-pub fn average_precision(relevant: &[bool], total_relevant: usize) -> f64 {
+pub(crate) fn average_precision(relevant: &[bool], total_relevant: usize) -> f64 {
     if total_relevant == 0 {
         return 0.0;
     }
@@ -138,7 +138,7 @@ pub fn average_precision(relevant: &[bool], total_relevant: usize) -> f64 {
 
 /// Fraction of the first `k` items that are relevant (a list shorter than
 /// `k` counts the missing places as not relevant).
-pub fn precision_at(relevant: &[bool], k: usize) -> f64 {
+pub(crate) fn precision_at(relevant: &[bool], k: usize) -> f64 {
     if k == 0 {
         return 0.0;
     }

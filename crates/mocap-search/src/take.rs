@@ -13,8 +13,11 @@
 //! standardised features ([`crate::dtw::subsequence_dtw`]); its matches may
 //! be of any length, so they follow the motion's real duration in the take.
 
+use std::path::Path;
+
 use serde::{Deserialize, Serialize};
 
+use crate::clips::load_features;
 use crate::dtw::subsequence_dtw;
 use crate::error::{Result, SearchError};
 use crate::forest::argmax;
@@ -29,6 +32,19 @@ pub enum TakeMethod {
     Windows,
     /// Subsequence DTW on the standardised features, at `dtw_fps`.
     SubsequenceDtw,
+}
+
+impl std::str::FromStr for TakeMethod {
+    type Err = SearchError;
+    fn from_str(s: &str) -> Result<TakeMethod> {
+        match s {
+            "windows" => Ok(TakeMethod::Windows),
+            "dtw" => Ok(TakeMethod::SubsequenceDtw),
+            other => Err(SearchError::Invalid(format!(
+                "unknown take search method `{other}`; expected windows or dtw"
+            ))),
+        }
+    }
 }
 
 /// How a take is searched. The default, windows compared by their forest
@@ -82,7 +98,7 @@ pub struct TakeMatch {
 }
 
 /// Intersection over union of two frame ranges.
-pub fn overlap(a: (usize, usize), b: (usize, usize)) -> f32 {
+pub(crate) fn overlap(a: (usize, usize), b: (usize, usize)) -> f32 {
     let inter = a.1.min(b.1).saturating_sub(a.0.max(b.0));
     let union = a.1.max(b.1) - a.0.min(b.0);
     if union == 0 {
@@ -90,6 +106,33 @@ pub fn overlap(a: (usize, usize), b: (usize, usize)) -> f32 {
     } else {
         inter as f32 / union as f32
     }
+}
+
+/// `mocap search find`: reads the query clip and the long take (BVH, or AMC
+/// next to its ASF) and finds the time ranges of the take most like the
+/// query ([`search_take`]).
+pub fn find_in_take(
+    index: &Index,
+    query: &Path,
+    take: &Path,
+    config: &TakeSearchConfig,
+) -> Result<TakeReport> {
+    let (query_features, query_fps) = load_features(query)?;
+    let (take_features, take_fps) = load_features(take)?;
+    let matches = search_take(
+        index,
+        &query_features,
+        query_fps,
+        &take_features,
+        take_fps,
+        config,
+    )?;
+    Ok(TakeReport {
+        query: query.display().to_string(),
+        take: take.display().to_string(),
+        take_seconds: take_features.frame_count() as f64 / take_fps,
+        matches,
+    })
 }
 
 /// The time ranges of `take` (per-frame features at `take_fps`) most like

@@ -1,4 +1,4 @@
-//! Motion search on real data: features, index files, queries, long takes
+//! Motion search on real data: index files, queries, long takes
 //! and a small evaluation on the Bandai Namco clips; the HDM05 ASF/AMC clip.
 //!
 //! The data is found at `<workspace>/../shared/data`, or where
@@ -8,15 +8,10 @@
 use mocap_testdata::shared_data;
 use std::path::{Path, PathBuf};
 
-use mocap_core::rotation::{Quat, Vec3};
-use mocap_core::{forward_kinematics, GlobalPoses};
-use mocap_search::eval::SplitRule;
-use mocap_search::features::{pose_features, KeyJoints, VALUE_COUNT};
-use mocap_search::index::Ranking;
-use mocap_search::take::{search_take, TakeSearchConfig};
 use mocap_search::{
-    build_index, evaluate, load_clips, load_motion, motion_files, EvalConfig, Index, IndexConfig,
-    LabelRule, NamePattern, SearchError,
+    build_index, evaluate, load_clips, motion_files, search_take, EvalConfig, FeatureSequence,
+    Index, IndexConfig, LabelRule, NamePattern, Ranking, SearchError, SplitRule, TakeSearchConfig,
+    VALUE_COUNT,
 };
 
 /// Every `step`-th dataset-1 clip of the given contents.
@@ -42,98 +37,6 @@ fn small_config(trees: usize) -> IndexConfig {
     let mut config = IndexConfig::default();
     config.forest.trees = trees;
     config
-}
-
-/// Moves, turns and scales the global poses of a whole take.
-fn transform(poses: &GlobalPoses, turn: Quat, shift: Vec3, scale: f32) -> GlobalPoses {
-    let mut out = poses.clone();
-    for p in &mut out.positions {
-        *p = turn * (*p * scale) + shift;
-    }
-    out
-}
-
-#[test]
-fn features_do_not_depend_on_place_heading_or_body_size() {
-    let Some(data) = shared_data() else { return };
-    let path = data.join("bandai/dataset-1/dataset-1_walk-left_normal_001.bvh");
-    let motion = load_motion(&path).unwrap();
-    let joints = KeyJoints::detect(motion.skeleton()).unwrap();
-    let parents: Vec<Option<usize>> = motion
-        .skeleton()
-        .joints()
-        .iter()
-        .map(|j| j.parent)
-        .collect();
-    let poses = forward_kinematics(&motion);
-    let base = pose_features(&poses, &joints, &parents, motion.fps()).unwrap();
-    assert_eq!(base.dim, VALUE_COUNT);
-    assert_eq!(base.frame_count(), motion.frame_count());
-    let moved = transform(
-        &poses,
-        Quat::from_rotation_y(2.1),
-        Vec3::new(300.0, 0.0, -120.0),
-        0.62,
-    );
-    let other = pose_features(&moved, &joints, &parents, motion.fps()).unwrap();
-    // Relative to the value's size where it exceeds 1: the wrist
-    // accelerations (values 74-75) are second differences of positions
-    // times fps², so they carry the positions' f32 rounding times 900.
-    let worst = base
-        .values
-        .iter()
-        .zip(&other.values)
-        .map(|(a, b)| (a - b).abs() / a.abs().max(1.0))
-        .fold(0.0f32, f32::max);
-    assert!(worst < 1e-3, "largest change {worst}");
-    // Bandai's walk-left travels diagonally forward and to the left with
-    // the body facing forward: the pelvis moves along +x (the body's left)
-    // and +z (forward). Walking right mirrors that; a turn to the left
-    // turns the facing direction counter-clockwise seen from above
-    // (positive turning speed).
-    let mean_of = |features: &mocap_search::intervals::FeatureSequence, i: usize| {
-        let n = features.frame_count();
-        (0..n).map(|f| features.frame(f)[i]).sum::<f32>() / n as f32
-    };
-    let mean = |i: usize| mean_of(&base, i);
-    let (vx, vz) = (mean(45), mean(47));
-    assert!(
-        vx > 0.15 && vz > 0.5,
-        "walk-left: pelvis velocity x {vx}, z {vz}"
-    );
-    let features = |file: &str| {
-        mocap_search::load_features(&data.join("bandai").join(file))
-            .unwrap()
-            .0
-    };
-    let right = features("dataset-1/dataset-1_walk-right_normal_001.bvh");
-    assert!(
-        mean_of(&right, 45) < -0.15,
-        "walk-right: x {}",
-        mean_of(&right, 45)
-    );
-    let back = features("dataset-1/dataset-1_walk-back_normal_001.bvh");
-    assert!(
-        mean_of(&back, 47) < -0.5,
-        "walk-back: z {}",
-        mean_of(&back, 47)
-    );
-    let turn = features("dataset-2/dataset-2_walk-turn-left_normal_001.bvh");
-    assert!(
-        mean_of(&turn, 48) > 0.3,
-        "turn left: {} rad/s",
-        mean_of(&turn, 48)
-    );
-    let turn = features("dataset-2/dataset-2_walk-turn-right_normal_001.bvh");
-    assert!(
-        mean_of(&turn, 48) < -0.3,
-        "turn right: {} rad/s",
-        mean_of(&turn, 48)
-    );
-    // Standing height: the pelvis is about half a body height above the
-    // floor.
-    let pelvis = mean(27);
-    assert!(pelvis > 0.35 && pelvis < 0.65, "pelvis height {pelvis}");
 }
 
 #[test]
@@ -246,7 +149,7 @@ fn a_query_finds_its_class_and_long_takes_find_the_clip() {
         values.extend_from_slice(&clip.features.values);
         ranges.push((clip.label.clone(), start, values.len() / VALUE_COUNT));
     }
-    let take = mocap_search::intervals::FeatureSequence {
+    let take = FeatureSequence {
         dim: VALUE_COUNT,
         values,
     };

@@ -16,9 +16,9 @@
 //! ([`crate::classify_net`]).
 
 use mocap_core::Motion;
-use mocap_search::features::motion_features;
-use mocap_search::forest::Samples;
-use mocap_search::intervals::{FeatureSequence, IntervalLayout};
+use mocap_search::motion_features;
+use mocap_search::Samples;
+use mocap_search::{FeatureSequence, IntervalLayout};
 use mocap_search::{Forest, ForestConfig};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -675,7 +675,7 @@ impl ClipClassifier {
     /// means).
     pub fn predict(&self, motion: &Motion) -> Result<String> {
         let votes = self.votes(motion)?;
-        Ok(self.classes[mocap_search::forest::argmax(&votes)].clone())
+        Ok(self.classes[mocap_search::argmax(&votes)].clone())
     }
 
     /// The summed score of every class (in the order of
@@ -762,7 +762,7 @@ mod tests {
         let nearest = |fitted: &RowModel, row: &[f32]| {
             let mut votes = [0.0f32; 2];
             fitted.add_votes(row, &mut votes);
-            mocap_search::forest::argmax(&votes)
+            mocap_search::argmax(&votes)
         };
         // (1.2, 1.5) lies along the shared swing from class 0's mean: the
         // Mahalanobis distances are 2.4 (class 0) and 26.6 (class 1), the

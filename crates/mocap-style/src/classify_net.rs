@@ -30,7 +30,7 @@ use burn::tensor::activation::{relu, softmax};
 use burn::tensor::{Device, Int, Tensor, TensorData};
 use mocap_nn::device::seed_device;
 use mocap_nn::train::{optimizer_step, work_bar};
-use mocap_search::intervals::FeatureSequence;
+use mocap_search::FeatureSequence;
 use rand::rngs::ChaCha8Rng;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;

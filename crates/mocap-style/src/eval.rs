@@ -529,7 +529,7 @@ impl MotionMeasures {
 /// (`left_ankle.x`, `right_ankle.x`).
 fn sideways_ankle_values() -> [usize; 2] {
     ["left_ankle.x", "right_ankle.x"].map(|name| {
-        mocap_search::features::VALUE_NAMES
+        mocap_search::VALUE_NAMES
             .iter()
             .position(|n| *n == name)
             .expect("a pose value of mocap-search")
@@ -975,7 +975,7 @@ fn draw_filmstrips(
         for (m, motion) in &outputs {
             rows.push(FilmstripRow::new(format!("output: {}", m.name()), motion));
         }
-        draw_filmstrip(&path, &rows, &model.description.rig, 8)?;
+        draw_filmstrip(&path, &rows, 8)?;
         paths.push(path);
     }
     Ok(paths)

@@ -1,6 +1,8 @@
 //! Writes example plots to the folder given (default: current folder), to
 //! look at: a rotation track, per-joint error bars, a confusion matrix.
-use mocap_view::plots::*;
+use mocap_view::{
+    plot_bars, plot_confusion, plot_lines, BarPlot, BarSeries, ConfusionPlot, LinePlot, Series,
+};
 fn main() {
     let dir = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
     let truth: Vec<f32> = (0..120).map(|i| 30.0 * (i as f32 * 0.08).sin()).collect();

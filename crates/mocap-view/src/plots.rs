@@ -12,15 +12,14 @@
 
 use std::ops::Range;
 use std::path::Path;
-use std::sync::Once;
 
 use mocap_core::io::atomic::write_bytes_atomically;
 use mocap_core::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::{register_font, FontStyle};
 
+use crate::fonts::register_fonts;
 use crate::scene::PALETTE;
 
 /// Draws with `$draw(&area, args...)` on a PNG or SVG drawing area (by the
@@ -108,8 +107,9 @@ pub struct LinePlot {
     pub x_label: String,
     pub y_label: String,
     pub series: Vec<Series>,
-    /// Logarithmic y axis (losses spanning decades); non-positive values are
-    /// left out.
+    /// Logarithmic y axis for losses spanning decades (drawn when the values
+    /// span more than a decade; a linear axis otherwise); non-positive
+    /// values are left out either way.
     pub log_y: bool,
     /// Width and height in pixels (PNG) or user units (SVG).
     pub size: (u32, u32),
@@ -186,13 +186,16 @@ pub fn plot_lines(path: &Path, plot: &LinePlot) -> Result<()> {
         )));
     }
     let x = padded(points().map(|p| p.0), 0.0);
-    let y = if plot.log_y {
-        let (lo, hi) = min_max(points().map(|p| p.1));
+    // A log axis labels only powers of ten: it is drawn when the values
+    // span more than a decade, else the axis stays linear.
+    let (lo, hi) = min_max(points().map(|p| p.1));
+    let log_axis = plot.log_y && hi > 10.0 * lo;
+    let y = if log_axis {
         lo / 1.5..hi * 1.5
     } else {
         padded(points().map(|p| p.1), 0.05)
     };
-    draw_to!(path, plot.size, draw_lines(plot, x, y))
+    draw_to!(path, plot.size, draw_lines(plot, x, y, log_axis))
 }
 
 fn draw_lines<DB: DrawingBackend>(
@@ -200,6 +203,7 @@ fn draw_lines<DB: DrawingBackend>(
     plot: &LinePlot,
     x: Range<f32>,
     y: Range<f32>,
+    log_axis: bool,
 ) -> std::result::Result<(), String> {
     let finite = |&(x, y): &(f32, f32)| x.is_finite() && y.is_finite() && (!plot.log_y || y > 0.0);
     {
@@ -266,7 +270,7 @@ fn draw_lines<DB: DrawingBackend>(
                 }
             }};
         }
-        if plot.log_y {
+        if log_axis {
             curves!(builder
                 .build_cartesian_2d(x.clone(), y.clone().log_scale())
                 .map_err(|e| e.to_string())?);
@@ -633,15 +637,6 @@ fn padded(values: impl Iterator<Item = f32>, margin: f32) -> Range<f32> {
     }
     let pad = (hi - lo) * margin;
     lo - pad..hi + pad
-}
-
-fn register_fonts() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // An embedded TTF always registers; were it to fail, the plot would
-        // lack its text but still show its data.
-        let _ = register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
-    });
 }
 
 enum PlotFormat {

@@ -1,5 +1,6 @@
 //! Pictures of motions drawn in Rust, without a browser: a filmstrip PNG
-//! (frames side by side) or an animated GIF, for reports and READMEs.
+//! (frames side by side, or one row of frames per motion) or an animated
+//! GIF, for reports and READMEs.
 //!
 //! The figures are drawn as in the web viewer: bones as lines, joints as
 //! rings, a floor grid of 0.5 m cells, a perspective camera looking at the
@@ -8,18 +9,17 @@
 //! Pictures are drawn at twice their size and averaged down for smooth
 //! edges.
 
-use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
 use mocap_core::io::atomic::write_bytes_atomically;
+use mocap_core::ops::FrameRange;
 use mocap_core::rotation::Vec3;
 use mocap_core::{Error, Result};
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 
+use crate::fonts::register_fonts;
 use crate::scene::{Scene, ViewMotion, PALETTE};
 
 /// How several motions share the picture.
@@ -32,6 +32,12 @@ pub enum Layout {
     /// in place under its hips so that takes that travel differently stay
     /// side by side.
     SideBySide,
+    /// A filmstrip with one row per motion (source, style clip, outputs),
+    /// each kept in place under its hips: the panels of a column show every
+    /// motion at the same moment, so a slower pace shows. The moments span
+    /// the shortest motion, and a row holds `columns` of them by default.
+    /// A GIF shows the motions side by side.
+    Rows,
 }
 
 /// What to draw and how big.
@@ -46,7 +52,8 @@ pub struct RenderOptions {
     /// Size of one panel of a filmstrip, or of the GIF, in pixels; `None`
     /// for 240 x 320 (filmstrip) or 480 x 400 per motion side by side (GIF).
     pub panel_size: Option<(u32, u32)>,
-    /// Filmstrip panels per row.
+    /// Filmstrip panels per row; with [`Layout::Rows`], the moments shown
+    /// when `every` is `None`.
     pub columns: usize,
     pub layout: Layout,
     /// Colour joints and bones by confidence (red 0 to green 1) where the
@@ -143,11 +150,19 @@ pub fn render(scene: &Scene, output: &Path, options: &RenderOptions) -> Result<R
         ));
     }
     let frames = pick_frames(scene, first, kind, options)?;
-    let stage = Stage::new(scene, first.frame_time, &frames, options);
     register_fonts();
     let (bytes, width, height) = match kind {
-        Output::Filmstrip => filmstrip(&stage, &frames, options)?,
-        Output::Gif => gif(&stage, &frames, first.frame_time, options)?,
+        Output::Filmstrip if options.layout == Layout::Rows => {
+            rows_filmstrip(scene, first.frame_time, &frames, options)?
+        }
+        Output::Filmstrip => {
+            let stage = Stage::new(scene, first.frame_time, &frames, options);
+            filmstrip(&stage, &frames, options)?
+        }
+        Output::Gif => {
+            let stage = Stage::new(scene, first.frame_time, &frames, options);
+            gif(&stage, &frames, first.frame_time, options)?
+        }
     };
     write_bytes_atomically(output, &bytes)?;
     Ok(RenderSummary {
@@ -158,72 +173,24 @@ pub fn render(scene: &Scene, output: &Path, options: &RenderOptions) -> Result<R
     })
 }
 
-/// Frames to draw, as written on the command line: `A..B` (frames `A` up
-/// to, not including, `B`, counted from 0 on the first motion's clock),
-/// `A..` (to the end) or `..B` (from the start). Parse with `str::parse`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct FrameRange {
-    pub start: Option<usize>,
-    pub end: Option<usize>,
-}
-
-impl FrameRange {
-    /// The frames `range`.
-    pub fn new(range: Range<usize>) -> FrameRange {
-        FrameRange {
-            start: Some(range.start),
-            end: Some(range.end),
-        }
-    }
-
-    /// The frames of a timeline of `frame_count` frames.
-    pub fn resolve(&self, frame_count: usize) -> Range<usize> {
-        self.start.unwrap_or(0)..self.end.unwrap_or(frame_count)
-    }
-}
-
-impl std::str::FromStr for FrameRange {
-    type Err = Error;
-
-    fn from_str(text: &str) -> Result<FrameRange> {
-        let bad = || {
-            Error::Invalid(format!(
-                "frame range `{text}`: expected A..B (frames A up to, not including, B, counted from 0), A.. or ..B"
-            ))
-        };
-        let (a, b) = text.split_once("..").ok_or_else(bad)?;
-        let number = |s: &str| -> Result<Option<usize>> {
-            let s = s.trim();
-            if s.is_empty() {
-                Ok(None)
-            } else {
-                s.parse().map(Some).map_err(|_| bad())
-            }
-        };
-        let (start, end) = (number(a)?, number(b)?);
-        if let (Some(a), Some(b)) = (start, end) {
-            if a >= b {
-                return Err(Error::Invalid(format!(
-                    "frame range `{text}` is empty: the first frame must come before the end"
-                )));
-            }
-        }
-        Ok(FrameRange { start, end })
-    }
-}
-
 /// Frames on the first motion's clock: the timeline lasts as long as the
-/// longest motion.
-fn timeline_frames(scene: &Scene, frame_time: f64) -> usize {
-    let longest = scene
+/// longest motion, or the shortest with `shortest`.
+fn timeline_frames(scene: &Scene, frame_time: f64, shortest: bool) -> usize {
+    let durations = scene
         .motions
         .iter()
-        .map(|m| m.frame_count.saturating_sub(1) as f64 * m.frame_time)
-        .fold(0.0, f64::max);
-    if scene.motions.iter().all(|m| m.frame_count == 0) {
+        .map(|m| m.frame_count.saturating_sub(1) as f64 * m.frame_time);
+    let span = if shortest {
+        durations.fold(f64::INFINITY, f64::min)
+    } else {
+        durations.fold(0.0, f64::max)
+    };
+    if scene.motions.iter().any(|m| m.frame_count == 0)
+        && (shortest || scene.motions.iter().all(|m| m.frame_count == 0))
+    {
         0
     } else {
-        (longest / frame_time + 1e-6).floor() as usize + 1
+        (span / frame_time + 1e-6).floor() as usize + 1
     }
 }
 
@@ -233,7 +200,8 @@ fn pick_frames(
     kind: Output,
     options: &RenderOptions,
 ) -> Result<Vec<usize>> {
-    let total = timeline_frames(scene, first.frame_time);
+    let rows = kind == Output::Filmstrip && options.layout == Layout::Rows;
+    let total = timeline_frames(scene, first.frame_time, rows);
     if total == 0 {
         return Err(Error::Invalid(format!(
             "{}: the motion has no frames",
@@ -249,6 +217,7 @@ fn pick_frames(
     }
     let count = range.end - range.start;
     let every = options.every.unwrap_or(match kind {
+        Output::Filmstrip if rows => count.div_ceil(options.columns).max(1),
         Output::Filmstrip => count.div_ceil(8).max(1),
         // GIF delays are whole hundredths of a second and browsers slow
         // down delays under 0.02 s: skip frames of faster takes.
@@ -301,7 +270,7 @@ impl<'a> Stage<'a> {
             .iter()
             .map(|m| m.bounding_box().unwrap_or((Vec3::ZERO, Vec3::ZERO)))
             .collect();
-        let in_place = options.layout == Layout::SideBySide;
+        let in_place = options.layout != Layout::Overlay;
         let mut offsets = vec![0.0; scene.motions.len()];
         if in_place {
             // Each motion stands on its own spot of a row, its hips kept
@@ -641,15 +610,6 @@ impl Camera {
     }
 }
 
-fn register_fonts() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // An embedded TTF always registers; were it to fail, pictures would
-        // lack their captions but still show the motion.
-        let _ = register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
-    });
-}
-
 /// An RGB picture drawn at `SUPER` times its size, then averaged down.
 struct Canvas {
     width: u32,
@@ -767,6 +727,56 @@ fn frame_caption<DB: DrawingBackend>(
         .map_err(|e| e.to_string())
 }
 
+/// One filmstrip panel: timeline frame `f` of `stage`, with `caption` in
+/// its top-left corner and, unless it is in the first column, a thin
+/// separator on its left edge.
+fn panel(
+    stage: &Stage,
+    f: usize,
+    size: (u32, u32),
+    caption: &str,
+    first_column: bool,
+) -> Result<RgbaImage> {
+    let (pw, ph) = size;
+    let s = SUPER as f32;
+    // Each panel is drawn on its own canvas, so that nothing spills into
+    // its neighbours.
+    let mut canvas = Canvas::new(pw, ph);
+    canvas.paint(|area| {
+        stage.draw(area, f, (0.0, 0.0), (pw as f32 * s, ph as f32 * s), s)?;
+        frame_caption(area, caption, (6 * SUPER as i32, 4 * SUPER as i32))
+    })?;
+    let mut panel = canvas.downsampled_rgba();
+    if !first_column {
+        for y in 0..ph {
+            panel.put_pixel(0, y, image::Rgba([200, 200, 196, 255]));
+        }
+    }
+    Ok(panel)
+}
+
+/// A picture with the legend strip of `scene` at its top, the rest in the
+/// background colour.
+fn picture_with_legend(scene: &Scene, width: u32, height: u32) -> Result<RgbaImage> {
+    let mut picture = RgbaImage::from_pixel(width, height, image::Rgba([244, 244, 242, 255]));
+    let mut legend = Canvas::new(width, LEGEND_HEIGHT);
+    legend.paint(|area| draw_legend(area, scene, (0, 0)))?;
+    image::imageops::replace(&mut picture, &legend.downsampled_rgba(), 0, 0);
+    Ok(picture)
+}
+
+fn encode_png(picture: RgbaImage) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    image::DynamicImage::ImageRgba8(picture)
+        .to_rgb8()
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| Error::Invalid(format!("PNG encoding failed: {e}")))?;
+    Ok(bytes)
+}
+
 fn filmstrip(
     stage: &Stage,
     frames: &[usize],
@@ -778,28 +788,11 @@ fn filmstrip(
     let rows = (frames.len() as u32).div_ceil(columns);
     let (width, height) = (pw * columns, LEGEND_HEIGHT + ph * rows);
     check_size(width, height)?;
-    let mut picture = RgbaImage::from_pixel(width, height, image::Rgba([244, 244, 242, 255]));
-    let s = SUPER as f32;
-    let mut legend = Canvas::new(width, LEGEND_HEIGHT);
-    legend.paint(|area| draw_legend(area, stage.scene, (0, 0)))?;
-    image::imageops::replace(&mut picture, &legend.downsampled_rgba(), 0, 0);
-    // Each panel is drawn on its own canvas, so that nothing spills into
-    // its neighbours.
+    let mut picture = picture_with_legend(stage.scene, width, height)?;
     for (k, &f) in frames.iter().enumerate() {
         let (col, row) = (k as u32 % columns, k as u32 / columns);
-        let mut panel = Canvas::new(pw, ph);
-        panel.paint(|area| {
-            stage.draw(area, f, (0.0, 0.0), (pw as f32 * s, ph as f32 * s), s)?;
-            let caption = format!("frame {f}  {:.2} s", f as f64 * stage.frame_time);
-            frame_caption(area, &caption, (6 * SUPER as i32, 4 * SUPER as i32))
-        })?;
-        let mut panel = panel.downsampled_rgba();
-        if col > 0 {
-            // A thin separator on the left edge.
-            for y in 0..ph {
-                panel.put_pixel(0, y, image::Rgba([200, 200, 196, 255]));
-            }
-        }
+        let caption = format!("frame {f}  {:.2} s", f as f64 * stage.frame_time);
+        let panel = panel(stage, f, (pw, ph), &caption, col == 0)?;
         image::imageops::replace(
             &mut picture,
             &panel,
@@ -807,15 +800,60 @@ fn filmstrip(
             (LEGEND_HEIGHT + row * ph) as i64,
         );
     }
-    let mut bytes = Vec::new();
-    image::DynamicImage::ImageRgba8(picture)
-        .to_rgb8()
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| Error::Invalid(format!("PNG encoding failed: {e}")))?;
-    Ok((bytes, width, height))
+    Ok((encode_png(picture)?, width, height))
+}
+
+/// [`Layout::Rows`]: one row of panels per motion, each motion alone on its
+/// stage in its own colour, all at one zoom so that sizes compare.
+fn rows_filmstrip(
+    scene: &Scene,
+    frame_time: f64,
+    frames: &[usize],
+    options: &RenderOptions,
+) -> Result<(Vec<u8>, u32, u32)> {
+    let (pw, ph) = options.panel_size.unwrap_or((240, 320));
+    check_size(pw, ph)?;
+    let alone: Vec<Scene> = scene
+        .motions
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let colour = m.colour.unwrap_or(PALETTE[i % PALETTE.len()]);
+            Scene::new(vec![m.clone().with_colour(colour)])
+        })
+        .collect();
+    let mut stages: Vec<Stage> = alone
+        .iter()
+        .map(|one| Stage::new(one, frame_time, frames, options))
+        .collect();
+    let radius = stages.iter().map(|s| s.radius).fold(0.0, f32::max);
+    for stage in &mut stages {
+        stage.radius = radius;
+    }
+    let (width, height) = (
+        pw * frames.len() as u32,
+        LEGEND_HEIGHT + ph * stages.len() as u32,
+    );
+    check_size(width, height)?;
+    let mut picture = picture_with_legend(scene, width, height)?;
+    for (row, stage) in stages.iter().enumerate() {
+        for (col, &f) in frames.iter().enumerate() {
+            let seconds = f as f64 * frame_time;
+            let caption = if col == 0 {
+                format!("{}  {seconds:.2} s", stage.scene.motions[0].label)
+            } else {
+                format!("{seconds:.2} s")
+            };
+            let panel = panel(stage, f, (pw, ph), &caption, col == 0)?;
+            image::imageops::replace(
+                &mut picture,
+                &panel,
+                (col as u32 * pw) as i64,
+                (LEGEND_HEIGHT + row as u32 * ph) as i64,
+            );
+        }
+    }
+    Ok((encode_png(picture)?, width, height))
 }
 
 fn gif(
@@ -824,7 +862,7 @@ fn gif(
     frame_time: f64,
     options: &RenderOptions,
 ) -> Result<(Vec<u8>, u32, u32)> {
-    let side_by_side = if options.layout == Layout::SideBySide {
+    let side_by_side = if options.layout != Layout::Overlay {
         stage.scene.motions.len().clamp(1, 3) as u32
     } else {
         1

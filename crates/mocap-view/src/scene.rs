@@ -78,7 +78,7 @@ impl ViewMotion {
         let skeleton = motion.skeleton();
         let joint_count = skeleton.joint_count();
         let mut names: Vec<String> = skeleton.joints().iter().map(|j| j.name.clone()).collect();
-        let mut parents: Vec<Option<usize>> = skeleton.joints().iter().map(|j| j.parent).collect();
+        let mut parents = skeleton.parents();
         for (j, joint) in skeleton.joints().iter().enumerate() {
             for k in 0..joint.end_sites.len() {
                 let suffix = if joint.end_sites.len() > 1 {
@@ -355,8 +355,15 @@ impl Scene {
         Ok(Scene::new(motions))
     }
 
-    /// The scene as compact JSON for the web viewer (format in the module
-    /// documentation of [`crate::server`]).
+    /// The scene as compact JSON for the web viewer:
+    /// `{"version": 1, "up": "y", "unit": "m", "motions": [...]}` where each
+    /// motion has `label`, `source`, `colour` (`#rrggbb`), `frame_time` (s),
+    /// `frame_count`, `joint_count`, `names` and `parents` of its points
+    /// (joints, then end sites), `bones` (per point: draw the bone from its
+    /// parent), `shown` (per point: draw it), `metres_per_unit` (the factor
+    /// applied to the file's numbers), `positions` (metres, `[x, y, z]` of
+    /// every point of frame 0, then frame 1, ... flattened) and `confidence`
+    /// (`null`, or one value in 0..1 per joint per frame).
     pub fn to_json(&self) -> String {
         let motions = self
             .motions
@@ -428,19 +435,19 @@ fn round_to(v: f32, scale: f32) -> f32 {
 }
 
 /// `#rrggbb`.
-pub fn hex_colour([r, g, b]: [u8; 3]) -> String {
+pub(crate) fn hex_colour([r, g, b]: [u8; 3]) -> String {
     format!("#{r:02x}{g:02x}{b:02x}")
 }
 
 /// The file name without its extension, for legends.
-pub fn file_label(path: &Path) -> String {
+pub(crate) fn file_label(path: &Path) -> String {
     path.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string())
 }
 
 /// Smallest and largest coordinates of `points`.
-pub fn bounding_box(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
+pub(crate) fn bounding_box(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
     let first = *points.first()?;
     Some(
         points
@@ -533,20 +540,10 @@ fn is_capture(path: &Path) -> bool {
 /// them.
 pub fn read_capture(path: &Path) -> Result<Vec<ViewMotion>> {
     use mocap_core::bodymap::KINECT_V2_JOINTS;
-    use mocap_core::error::{Location, ParseError};
     use std::collections::BTreeMap;
 
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let at = |line: usize, message: String| {
-        Error::Parse(ParseError {
-            location: Location {
-                path: path.to_path_buf(),
-                line,
-                column: 1,
-            },
-            message,
-        })
-    };
+    let at = |line: usize, message: String| Error::parse(path, line, 1, message);
     let joint_count = KINECT_V2_JOINTS.len();
     // Per stream (a sensor id, or None for fused frames): (time, points, confidence).
     type Frame = (f64, Vec<Vec3>, Vec<f32>);

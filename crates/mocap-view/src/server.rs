@@ -5,16 +5,7 @@
 //! | --- | --- |
 //! | `/` | the page (`page/index.html`) |
 //! | `/viewer.js` | the viewer (`page/viewer.js`): a 2D canvas with a perspective camera |
-//! | `/scene.json` | the motions ([`Scene::to_json`]) |
-//!
-//! `scene.json` is `{"version": 1, "up": "y", "unit": "m", "motions": [...]}`
-//! where each motion has `label`, `source`, `colour` (`#rrggbb`),
-//! `frame_time` (s), `frame_count`, `joint_count`, `names` and `parents` of
-//! its points (joints, then end sites), `bones` (per point: draw the bone
-//! from its parent), `shown` (per point: draw it), `metres_per_unit` (the factor applied
-//! to the file's numbers), `positions` (metres, `[x, y, z]` of every point of
-//! frame 0, then frame 1, ... flattened) and `confidence` (`null`, or one
-//! value in 0..1 per joint per frame).
+//! | `/scene.json` | the motions ([`Scene::to_json`], which gives the format) |
 //!
 //! Nothing is fetched from the network: the page works offline. The server
 //! listens on 127.0.0.1 only and answers only requests addressed to a

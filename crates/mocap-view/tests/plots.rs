@@ -2,10 +2,10 @@
 
 use std::path::Path;
 
-use mocap_view::plots::{
+use mocap_view::{
     plot_bars, plot_confusion, plot_lines, BarPlot, BarSeries, ConfusionPlot, LinePlot, Series,
+    PALETTE,
 };
-use mocap_view::scene::PALETTE;
 
 fn pixels_near(path: &Path, colour: [u8; 3]) -> usize {
     let img = image::open(path).unwrap().to_rgb8();

@@ -1,16 +1,14 @@
 //! Filmstrips and GIFs: the right frames, the figures on them in their
 //! colours, side by side where asked, and clear errors.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use image::AnimationDecoder;
 use mocap_core::rotation::Vec3;
-use mocap_view::render::{FrameRange, Layout, RenderOptions};
-use mocap_view::scene::PALETTE;
-use mocap_view::{render, Scene, ViewMotion};
+use mocap_view::{render, FrameRange, Layout, RenderOptions, Scene, ViewMotion, PALETTE};
 
 fn sample() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../samples/dataset-1_walk_normal_001.bvh")
+    mocap_testdata::sample_walk()
 }
 
 /// Pixels within 30 of `colour` on every channel, in the rectangle.
@@ -60,6 +58,35 @@ fn filmstrip_of_the_sample_shows_the_figure_in_every_panel() {
         let n = count_near(&img, colour, k * 240..(k + 1) * 240, 26..img.height());
         // A figure's bones and joints cover hundreds of pixels.
         assert!(n > 300, "panel {k}: {n} pixels of the motion's colour");
+    }
+}
+
+#[test]
+fn rows_show_each_motion_on_its_own_row_at_the_same_moments() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rows.png");
+    let proud = mocap_testdata::sample("dataset-1_walk_proud_001.bvh");
+    let scene = Scene::from_files(&[sample(), proud]).unwrap();
+    let options = RenderOptions {
+        layout: Layout::Rows,
+        columns: 4,
+        ..RenderOptions::default()
+    };
+    let summary = render(&scene, &out, &options).unwrap();
+    // Four moments over the shorter take, on the first take's clock.
+    assert_eq!(summary.frames.len(), 4);
+    assert_eq!(summary.frames[0], 0);
+    assert_eq!((summary.width, summary.height), (4 * 240, 26 + 2 * 320));
+    let img = image::open(&out).unwrap().to_rgb8();
+    for (row, colour) in PALETTE.iter().take(2).enumerate() {
+        let rows = 26 + row as u32 * 320..26 + (row as u32 + 1) * 320;
+        for k in 0..4 {
+            let n = count_near(&img, *colour, k * 240..(k + 1) * 240, rows.clone());
+            assert!(n > 300, "row {row}, panel {k}: {n} pixels of its colour");
+        }
+        // The other motion's colour is not on this row.
+        let other = PALETTE[1 - row];
+        assert!(count_near(&img, other, 0..img.width(), rows.clone()) < 50);
     }
 }
 
@@ -228,10 +255,10 @@ fn confidence_colours_the_joints() {
     render(&scene, &out, &options).unwrap();
     let img = image::open(&out).unwrap().to_rgb8();
     let body = image::imageops::crop_imm(&img, 0, 26, img.width(), 200).to_image();
-    let red = mocap_view::render::confidence_colour(0.0);
+    let red = mocap_view::confidence_colour(0.0);
     assert!(red[0] > 180 && red[1] < 60 && red[2] < 60, "{red:?}");
     assert!(count_near(&body, red, 0..body.width(), 0..200) > 100);
     assert_eq!(count_near(&body, PALETTE[0], 0..body.width(), 0..200), 0);
-    let green = mocap_view::render::confidence_colour(1.0);
+    let green = mocap_view::confidence_colour(1.0);
     assert!(green[1] > 150 && green[0] < 60, "{green:?}");
 }

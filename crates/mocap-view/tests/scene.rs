@@ -8,8 +8,7 @@ use mocap_core::io::asf_amc::read_asf_amc;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::kinematics::{end_site_positions, forward_kinematics};
 use mocap_core::rotation::Vec3;
-use mocap_view::scene::{guess_metres_per_unit, read_capture};
-use mocap_view::{Scene, ViewMotion};
+use mocap_view::{guess_metres_per_unit, read_capture, Scene, ViewMotion};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -1,9 +1,11 @@
+//! `mocap convert`: read, join, edit and write motions (mocap-core).
+
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context};
-use mocap_core::io::{self, MotionSource};
-use mocap_core::ops;
-use mocap_core::retarget::Retargeting;
+use anyhow::bail;
+use mocap_core::convert::{convert_files, ConvertOptions};
+use mocap_core::io::write_motion;
+use mocap_core::ops::FrameRange;
 
 use super::GlobalOptions;
 
@@ -26,9 +28,9 @@ pub struct Args {
     /// Multiply every length (offsets, positions) by this factor, e.g. 0.01 for cm -> m.
     #[arg(long)]
     scale: Option<f32>,
-    /// Keep frames A..B (0-based, B excluded; `A..` to the end).
+    /// Keep frames A..B (0-based, B excluded; `A..` to the end, `..B` from the start).
     #[arg(long, value_name = "A..B")]
-    frames: Option<String>,
+    frames: Option<FrameRange>,
     /// Play the motion on the rig of this BVH file: body parts matched by joint name, bone
     /// directions kept, strides scaled by the legs' lengths. The first frames of the input and
     /// of this file are the two rigs' reference poses (best both standing or both T-poses).
@@ -36,60 +38,20 @@ pub struct Args {
     retarget_to: Option<PathBuf>,
 }
 
-/// Parses `A..B` or `A..` into a frame range for a take of `len` frames.
-fn parse_frame_range(text: &str, len: usize) -> anyhow::Result<std::ops::Range<usize>> {
-    let (a, b) = text
-        .split_once("..")
-        .ok_or_else(|| anyhow!("--frames {text:?}: expected A..B, e.g. 100..400"))?;
-    let start: usize = a
-        .trim()
-        .parse()
-        .with_context(|| format!("--frames {text:?}: {a:?} is not a frame number"))?;
-    let end: usize = if b.trim().is_empty() {
-        len
-    } else {
-        b.trim()
-            .parse()
-            .with_context(|| format!("--frames {text:?}: {b:?} is not a frame number"))?
-    };
-    Ok(start..end)
-}
-
 pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     let (output, inputs) = match args.paths.split_last() {
         Some((output, inputs)) if !inputs.is_empty() => (output, inputs),
         _ => bail!("`mocap convert` needs at least one input and an output path"),
     };
-    let mut motions = io::read_motions(inputs)?.into_iter();
-    let Some((first, mut motion)) = motions.next() else {
-        bail!("no input motion given");
+    let convert = ConvertOptions {
+        frames: args.frames,
+        fps: args.fps,
+        mirror: args.mirror,
+        scale: args.scale,
+        retarget_to: args.retarget_to,
     };
-    let first = MotionSource::display_name(&first);
-    for (source, next) in motions {
-        motion
-            .append(&next)
-            .with_context(|| format!("joining {}", MotionSource::display_name(&source)))?;
-    }
-    if let Some(range) = &args.frames {
-        let range = parse_frame_range(range, motion.frame_count())?;
-        motion = ops::trim(&motion, range)?;
-    }
-    if let Some(fps) = args.fps {
-        motion = ops::resample_fps(&motion, fps)?;
-    }
-    if args.mirror {
-        motion = ops::mirror_auto(&motion).with_context(|| format!("mirroring {first}"))?;
-    }
-    if let Some(factor) = args.scale {
-        motion = ops::scale(&motion, factor);
-    }
-    if let Some(rig) = &args.retarget_to {
-        let target = io::bvh::read_bvh(rig)?;
-        motion = Retargeting::detect(&motion, &target)
-            .and_then(|r| r.apply(&motion))
-            .with_context(|| format!("retargeting onto the rig of {}", rig.display()))?;
-    }
-    io::write_motion(output, &motion)?;
+    let motion = convert_files(inputs, &convert)?;
+    write_motion(output, &motion)?;
     if !options.quiet {
         eprintln!(
             "wrote {} ({} frames at {:.3} fps, {} joints)",

@@ -11,8 +11,8 @@ use super::GlobalOptions;
 #[derive(clap::Args)]
 pub struct Args {
     /// The report folder (index.html, report.json, BVH outputs, pictures).
-    #[arg(long, default_value = "mocap-demo-report")]
-    out: PathBuf,
+    #[arg(long, short, default_value = "mocap-demo-report")]
+    output: PathBuf,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
@@ -48,7 +48,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
         anyhow::bail!("--sensors must be at least 1");
     }
     let demo = DemoOptions {
-        out: args.out,
+        out: args.output,
         sample: args.sample.unwrap_or(defaults.sample),
         style_clip: args.style_clip.unwrap_or(defaults.style_clip),
         clean_model: args.clean_model.unwrap_or(defaults.clean_model),

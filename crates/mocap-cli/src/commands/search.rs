@@ -3,13 +3,12 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context};
-use mocap_search::eval::evaluate_train_test;
-use mocap_search::take::{TakeMethod, TakeReport};
 use mocap_search::{
-    build_index, evaluate, load_clips, load_features, motion_files, search_take, EvalConfig, Index,
-    IndexConfig, LabelFile, LabelRule, NamePattern, Ranking, SplitRule, TakeSearchConfig,
+    evaluate_files, find_in_take, index_files, EvalConfig, Index, IndexConfig, LabelFile,
+    LabelRule, NamePattern, Ranking, SplitRule, TakeMethod, TakeSearchConfig,
 };
 
+use super::args::ReportArgs;
 use super::{write_output, GlobalOptions};
 
 #[derive(clap::Args)]
@@ -30,10 +29,10 @@ enum SearchCommand {
     Eval(EvalArgs),
 }
 
-/// Where each clip's category comes from.
+/// Where each clip's category comes from (shared by `index` and `eval`).
 #[derive(clap::Args)]
 #[group(required = true, multiple = false)]
-struct LabelArgs {
+struct SearchLabelArgs {
     /// A CSV/TSV file of `path,label[,performer]` lines.
     #[arg(long)]
     labels: Option<PathBuf>,
@@ -43,7 +42,7 @@ struct LabelArgs {
     labels_from_name: Option<String>,
 }
 
-impl LabelArgs {
+impl SearchLabelArgs {
     fn rule(&self) -> anyhow::Result<(LabelRule, String)> {
         Ok(match (&self.labels, &self.labels_from_name) {
             (Some(file), _) => (
@@ -61,7 +60,7 @@ impl LabelArgs {
 
 /// Forest settings shared by `index` and `eval`.
 #[derive(clap::Args)]
-struct ForestArgs {
+struct SearchForestArgs {
     /// Number of trees.
     #[arg(long, default_value_t = 100)]
     trees: usize,
@@ -82,7 +81,7 @@ struct ForestArgs {
     no_bootstrap: bool,
 }
 
-impl ForestArgs {
+impl SearchForestArgs {
     fn config(&self) -> IndexConfig {
         let mut config = IndexConfig {
             frames: self.frames,
@@ -103,9 +102,9 @@ struct IndexArgs {
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
-    labels: LabelArgs,
+    labels: SearchLabelArgs,
     #[command(flatten)]
-    forest: ForestArgs,
+    forest: SearchForestArgs,
     /// The index file to write.
     #[arg(long, short)]
     output: PathBuf,
@@ -144,8 +143,8 @@ struct FindArgs {
     #[arg(long, default_value_t = 10)]
     top: usize,
     /// windows (sliding windows of several lengths) or dtw (subsequence DTW).
-    #[arg(long, default_value = "windows", value_parser = ["windows", "dtw"])]
-    method: String,
+    #[arg(long, default_value = "windows")]
+    method: TakeMethod,
     /// How windows are compared with the query: histogram, proximity or features (as for query).
     #[arg(long, default_value = "histogram")]
     rank: Ranking,
@@ -160,9 +159,9 @@ struct EvalArgs {
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
-    labels: LabelArgs,
+    labels: SearchLabelArgs,
     #[command(flatten)]
-    forest: ForestArgs,
+    forest: SearchForestArgs,
     /// Stratified K-fold cross-validation by take.
     #[arg(long, default_value_t = 5)]
     folds: usize,
@@ -185,12 +184,8 @@ struct EvalArgs {
     /// The data's name in the report.
     #[arg(long)]
     name: Option<String>,
-    /// Print JSON instead of Markdown.
-    #[arg(long)]
-    json: bool,
-    /// Also write the report to this file.
-    #[arg(long, short)]
-    output: Option<PathBuf>,
+    #[command(flatten)]
+    report: ReportArgs,
     /// Write a confusion matrix per method here (`confusion-<method>.png` and `.svg`).
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
@@ -201,8 +196,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     match args.command {
         SearchCommand::Index(a) => {
             let (rule, rule_name) = a.labels.rule()?;
-            let clips = load_clips(&motion_files(&a.inputs)?, &rule, progress)?;
-            let index = build_index(&clips, &rule_name, &a.forest.config(), progress)?;
+            let index = index_files(&a.inputs, &rule, &rule_name, &a.forest.config(), progress)?;
             index.save(&a.output)?;
             if !options.quiet {
                 let plural = |n: usize, one: &str, many: &str| {
@@ -210,16 +204,14 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 };
                 eprintln!(
                     "indexed {} of {} into {}",
-                    plural(clips.len(), "clip", "clips"),
+                    plural(index.clips.len(), "clip", "clips"),
                     plural(index.classes.len(), "class", "classes"),
                     a.output.display()
                 );
             }
         }
         SearchCommand::Query(a) => {
-            let index = Index::load(&a.index)?;
-            let (features, _fps) = load_features(&a.clip)?;
-            let report = index.query(&a.clip.display().to_string(), &features, a.top, a.rank);
+            let report = Index::load(&a.index)?.query_file(&a.clip, a.top, a.rank)?;
             print_result(&report, a.json, || report.to_text())?;
             let missing = report.missing_clips();
             if missing > 0 && !options.quiet {
@@ -232,33 +224,24 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             }
         }
         SearchCommand::Find(a) => {
-            let index = Index::load(&a.index)?;
-            let (query, query_fps) = load_features(&a.clip)?;
-            let (take, take_fps) = load_features(&a.take)?;
-            let method = match a.method.as_str() {
-                "windows" => TakeMethod::Windows,
-                "dtw" => TakeMethod::SubsequenceDtw,
-                other => bail!("--method {other:?}: expected windows or dtw"),
-            };
             let config = TakeSearchConfig {
-                method,
+                method: a.method,
                 ranking: a.rank,
                 top: a.top,
                 ..TakeSearchConfig::default()
             };
-            let matches = search_take(&index, &query, query_fps, &take, take_fps, &config)?;
-            let report = TakeReport {
-                query: a.clip.display().to_string(),
-                take: a.take.display().to_string(),
-                take_seconds: take.frame_count() as f64 / take_fps,
-                matches,
-            };
+            let report = find_in_take(&Index::load(&a.index)?, &a.clip, &a.take, &config)?;
             print_result(&report, a.json, || report.to_text())?;
         }
         SearchCommand::Eval(a) => {
             let (rule, rule_name) = a.labels.rule()?;
-            let mut config = EvalConfig {
+            let config = EvalConfig {
                 index: a.forest.config(),
+                split: if a.by_performer {
+                    SplitRule::ByPerformer
+                } else {
+                    SplitRule::Folds { k: a.folds }
+                },
                 seed: a.forest.seed,
                 baselines: !a.no_baselines,
                 unseen_classes: !a.no_unseen,
@@ -266,33 +249,28 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                 progress,
                 ..EvalConfig::default()
             };
-            config.split = if a.by_performer {
-                SplitRule::ByPerformer
+            let report = evaluate_files(
+                &a.inputs,
+                &a.test,
+                &rule,
+                &rule_name,
+                a.name.as_deref(),
+                &config,
+            )?;
+            let markdown = report.to_markdown();
+            if a.report.json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).context("writing JSON")?
+                );
             } else {
-                SplitRule::Folds { k: a.folds }
-            };
-            let dataset = a.name.clone().unwrap_or_else(|| {
-                let names: Vec<String> = a.inputs.iter().map(|d| d.display().to_string()).collect();
-                names.join(" + ")
-            });
-            let clips = load_clips(&motion_files(&a.inputs)?, &rule, progress)?;
-            let report = if a.test.is_empty() {
-                evaluate(&clips, &dataset, &rule_name, &config)?
-            } else {
-                let test = load_clips(&motion_files(&a.test)?, &rule, progress)?;
-                evaluate_train_test(&clips, &test, &dataset, &rule_name, &config)?
-            };
-            let text = if a.json {
-                serde_json::to_string_pretty(&report).context("writing JSON")?
-            } else {
-                report.to_markdown()
-            };
-            println!("{text}");
-            if let Some(path) = &a.output {
-                write_output(Some(path), |w| w.write_all(text.as_bytes()))?;
+                println!("{markdown}");
+            }
+            if let Some(path) = &a.report.markdown {
+                write_output(Some(path), |w| w.write_all(markdown.as_bytes()))?;
             }
             if let Some(dir) = &a.plots {
-                let written = plot_confusions(&report, dir)?;
+                let written = report.plot_confusions(dir)?;
                 if !options.quiet {
                     eprintln!("wrote {written} confusion matrices to {}", dir.display());
                 }
@@ -300,52 +278,6 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// One confusion matrix per method (rows: true class, as fractions of the
-/// row: each row's diagonal is the class's recall), PNG and SVG.
-fn plot_confusions(
-    report: &mocap_search::EvalReport,
-    dir: &std::path::Path,
-) -> anyhow::Result<usize> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let classes = report.classes.len();
-    let side = (240 + 28 * classes as u32).min(2000);
-    let mut written = 0;
-    for method in &report.methods {
-        let counts = (0..classes)
-            .map(|truth| {
-                (0..classes)
-                    .map(|predicted| method.confusion.count(truth, predicted) as f32)
-                    .collect()
-            })
-            .collect();
-        let plot = mocap_view::ConfusionPlot {
-            title: format!("{} (accuracy {:.3})", method.method, method.accuracy),
-            labels: report.classes.clone(),
-            counts,
-            normalise_rows: true,
-            size: (side, side),
-        };
-        let stem: String = method
-            .method
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() {
-                    c.to_ascii_lowercase()
-                } else {
-                    '-'
-                }
-            })
-            .collect();
-        for extension in ["png", "svg"] {
-            let path = dir.join(format!("confusion-{stem}.{extension}"));
-            mocap_view::plot_confusion(&path, &plot)
-                .with_context(|| format!("drawing {}", path.display()))?;
-        }
-        written += 1;
-    }
-    Ok(written)
 }
 
 /// Prints a result as pretty JSON or as the text `to_text` gives.

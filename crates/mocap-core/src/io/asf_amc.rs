@@ -77,7 +77,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Location, ParseError, Result};
+use crate::error::{Error, Result};
 use crate::motion::Motion;
 use crate::rotation::{AngleUnit, Axis, Quat, Vec3};
 use crate::skeleton::{Channel, DofLimit, Joint, RangeOfMotion, Skeleton};
@@ -532,14 +532,7 @@ impl Errors<'_> {
     /// An error at byte `offset` of `line` (column counted in characters).
     fn at(&self, number: usize, line: &str, offset: usize, message: impl Into<String>) -> Error {
         let column = line[..offset.min(line.len())].chars().count() + 1;
-        Error::Parse(ParseError {
-            location: Location {
-                path: self.path.to_path_buf(),
-                line: number,
-                column,
-            },
-            message: message.into(),
-        })
+        Error::parse(self.path, number, column, message)
     }
 
     fn at_token(

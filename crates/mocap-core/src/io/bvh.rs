@@ -59,7 +59,7 @@
 //!   in any encoding);
 //! - blank lines between or after the frame lines.
 //!
-//! It refuses, with a [`ParseError`] naming the file, the 1-based line and
+//! It refuses, with a [`ParseError`](crate::ParseError) naming the file, the 1-based line and
 //! column (counted in bytes) and what was expected: a frame line with the
 //! wrong number of values, fewer or more frame lines than `Frames:` announced,
 //! an unknown channel name, a `CHANNELS n` line that lists another number of
@@ -88,7 +88,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Location, ParseError, Result};
+use crate::error::{Error, Result};
 use crate::io::atomic::write_atomically;
 use crate::motion::Motion;
 use crate::rotation::Vec3;
@@ -383,7 +383,7 @@ impl<R: BufRead> Lines<R> {
     }
 
     fn error(&self, line: usize, column: usize, message: impl Into<String>) -> Error {
-        parse_error(&self.path, line, column, message)
+        Error::parse(&self.path, line, column, message)
     }
 
     /// An error at a column of the current line.
@@ -399,17 +399,6 @@ impl<R: BufRead> Lines<R> {
         let (line, column) = self.end_of_file();
         self.error(line, column, message)
     }
-}
-
-fn parse_error(path: &Path, line: usize, column: usize, message: impl Into<String>) -> Error {
-    Error::Parse(ParseError {
-        location: Location {
-            path: path.to_path_buf(),
-            line,
-            column,
-        },
-        message: message.into(),
-    })
 }
 
 /// The words of a line separated by ASCII whitespace, each with its byte

@@ -115,17 +115,18 @@ pub fn write_motion(path: &Path, motion: &Motion) -> Result<()> {
     }
 }
 
-/// The BVH files among `inputs` (files as given, folders searched
-/// recursively), sorted and without repeats. An input that does not exist,
-/// or no BVH file at all, is an error naming the inputs.
-pub fn find_bvh_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
+/// The files among `inputs` whose extension is one of `extensions` (lower
+/// case; files are matched in any case): files as given, folders searched
+/// recursively; sorted and without repeats. An input that does not exist is
+/// an error naming it.
+pub fn find_files(inputs: &[PathBuf], extensions: &[&str]) -> Result<Vec<PathBuf>> {
+    fn walk(dir: &Path, extensions: &[&str], out: &mut Vec<PathBuf>) -> Result<()> {
         let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
         for entry in entries {
             let path = entry.map_err(|e| Error::io(dir, e))?.path();
             if path.is_dir() {
-                walk(&path, out)?;
-            } else if extension(&path) == "bvh" {
+                walk(&path, extensions, out)?;
+            } else if extensions.contains(&extension(&path).as_str()) {
                 out.push(path);
             }
         }
@@ -134,7 +135,7 @@ pub fn find_bvh_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for input in inputs {
         if input.is_dir() {
-            walk(input, &mut out)?;
+            walk(input, extensions, &mut out)?;
         } else if input.is_file() {
             out.push(input.clone());
         } else {
@@ -146,6 +147,14 @@ pub fn find_bvh_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     }
     out.sort();
     out.dedup();
+    Ok(out)
+}
+
+/// The BVH files among `inputs` (files as given, folders searched
+/// recursively), sorted and without repeats. An input that does not exist,
+/// or no BVH file at all, is an error naming the inputs.
+pub fn find_bvh_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let out = find_files(inputs, &["bvh"])?;
     if out.is_empty() {
         let names: Vec<String> = inputs.iter().map(|p| p.display().to_string()).collect();
         return Err(Error::Invalid(format!(

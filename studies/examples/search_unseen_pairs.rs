@@ -1,10 +1,10 @@
-//! Experiment (issue 5): is dataset-1's content F low because each test
+//! Is dataset-1's content F low because each test
 //! clip shows its content in a style the forest never saw *with that
 //! content*? Measured on dataset-2, whose 70 (content, style) pairs hold
 //! about 14 takes each, by splits that put dataset-2 in dataset-1's place.
 //!
 //! ```text
-//! cargo run --profile test -p mocap-search --example unseen_pairs -- \
+//! cargo run --profile test -p mocap-studies --example search_unseen_pairs -- \
 //!     ../shared/data/bandai/dataset-2 [SEEDS] > bench/search/out/unseen-pairs.md
 //! ```
 //!
@@ -32,17 +32,20 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand::seq::IndexedRandom;
 use rand::SeedableRng;
 
-use mocap_search::eval::stratified_folds;
-use mocap_search::forest::{argmax, Samples};
-use mocap_search::intervals::IntervalLayout;
-use mocap_search::scores::ConfusionMatrix;
-use mocap_search::{load_clips, motion_files, Forest, ForestConfig, LabelRule, NamePattern};
+use mocap_search::{
+    argmax, load_clips, motion_files, ConfusionMatrix, Forest, ForestConfig, IntervalLayout,
+    LabelRule, NamePattern, Samples,
+};
+use mocap_studies::search::stratified_folds;
 
 const N: usize = 10;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let dir = PathBuf::from(args.next().ok_or("usage: unseen_pairs DIR [SEEDS]")?);
+    let dir = PathBuf::from(
+        args.next()
+            .ok_or("usage: search_unseen_pairs DIR [SEEDS]")?,
+    );
     let seeds: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(3);
     let files = motion_files(&[dir])?;
     let content_rule = LabelRule::FromName(NamePattern::parse("bandai-content")?);

@@ -2,7 +2,7 @@
 //! prints the Markdown report (or JSON with `--json`).
 //!
 //! ```text
-//! cargo run --release -p mocap-search --example search_eval -- \
+//! cargo run --release -p mocap-studies --example search_eval -- \
 //!     --labels-from-name bandai-content --folds 5 ../shared/data/bandai/dataset-2
 //! ```
 //!
@@ -13,15 +13,12 @@
 //! (the second macro average, over classes with at least M clips; default
 //! 10); `--no-baselines`,
 //! `--no-unseen`, `--no-takes`; `--name NAME` (the data's name in the
-//! report); `--json`; `--out FILE` writes the report there too (atomically).
+//! report); `--json`; `--output FILE` writes the report there too (atomically).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use mocap_search::eval::evaluate_train_test;
-use mocap_search::{
-    evaluate, load_clips, motion_files, EvalConfig, LabelFile, LabelRule, NamePattern, SplitRule,
-};
+use mocap_search::{evaluate_files, EvalConfig, LabelFile, LabelRule, NamePattern, SplitRule};
 
 fn main() -> ExitCode {
     match run() {
@@ -84,7 +81,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             "--no-takes" => config.takes = false,
             "--name" => name = Some(value(&mut args, &arg)?),
             "--json" => json = true,
-            "--out" => out = Some(PathBuf::from(value(&mut args, &arg)?)),
+            "--output" => out = Some(PathBuf::from(value(&mut args, &arg)?)),
             flag if flag.starts_with("--") => return Err(format!("unknown option {flag}").into()),
             dir => dirs.push(PathBuf::from(dir)),
         }
@@ -93,19 +90,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     if dirs.is_empty() {
         return Err("give at least one folder of clips".into());
     }
-    let dataset = name.unwrap_or_else(|| {
-        dirs.iter()
-            .map(|d| d.display().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
-    });
-    let clips = load_clips(&motion_files(&dirs)?, &rule, true)?;
-    let report = if test_dirs.is_empty() {
-        evaluate(&clips, &dataset, &rule_name, &config)?
-    } else {
-        let test = load_clips(&motion_files(&test_dirs)?, &rule, true)?;
-        evaluate_train_test(&clips, &test, &dataset, &rule_name, &config)?
-    };
+    let report = evaluate_files(
+        &dirs,
+        &test_dirs,
+        &rule,
+        &rule_name,
+        name.as_deref(),
+        &config,
+    )?;
     let text = if json {
         serde_json::to_string_pretty(&report)?
     } else {
