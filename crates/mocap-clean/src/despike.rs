@@ -44,7 +44,7 @@
 //! first frame after it. Long spikes are bridged with a straight path, which
 //! loses whatever the joint really did meanwhile, but it is much closer than
 //! another person's motion.
-//! `mocap clean --despike` does this before a filter or a denoiser runs,
+//! `mocap clean apply --despike` does this before a filter or a denoiser runs,
 //! which would smear each spike's jumps over the frames around it and take
 //! part of it for noise (bench/results/clean.md).
 
@@ -75,8 +75,8 @@ pub struct DespikeOptions {
     /// also by its own. A spike there swaps several limbs, which jump, but
     /// the trunk joint itself often turns little: both the take and the
     /// motion it was swapped with stand upright (bench/results/clean.md,
-    /// "Spikes of the trunk"). On by default since session 22; settings
-    /// written before then read it as off, which is how they ran.
+    /// "Spikes of the trunk"). On by default; settings written without it
+    /// read it as off, which is how they ran.
     #[serde(default)]
     pub trunk_by_subtree: bool,
 }
