@@ -65,7 +65,7 @@ pub struct DespikeOptions {
     /// Jumps of global rotations (forward kinematics) instead of local ones.
     /// Noise of IK on keypoints errs on the local rotations by several times
     /// its level (a joint swings to keep its child near the keypoint,
-    /// [`crate::noise`]) but on the global ones by about its level, while a
+    /// [`crate::RandomNoise`]) but on the global ones by about its level, while a
     /// spike turns its whole subtree in both: spike boundaries stand out far
     /// better in global rotations (bench/results/clean.md).
     #[serde(default)]

@@ -37,7 +37,7 @@ impl CleanModel {
 
     /// [`CleanModel::clean`], also returning the noise level (degrees) its
     /// Wiener filter estimated for the take, when it corrects one
-    /// ([`ModelDescription::base_wiener`]) and that filter sees the whole take.
+    /// ([`crate::ModelDescription::base_wiener`]) and that filter sees the whole take.
     pub fn clean_reporting(
         &self,
         motion: &Motion,
@@ -247,7 +247,7 @@ pub struct CleanOptions {
     /// Frames between window starts (default: a quarter window).
     pub hop: Option<usize>,
     /// Look for spikes in the input and bridge them before cleaning
-    /// ([`crate::despike`]).
+    /// ([`crate::remove_spikes`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
 }

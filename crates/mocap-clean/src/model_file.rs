@@ -60,7 +60,7 @@ pub struct ModelDescription {
     /// a 32-frame window is poor) is trained with nearly what it sees in use.
     #[serde(default)]
     pub base_context: usize,
-    /// A learned Wiener filter ([`crate::wiener`]) the network corrects
+    /// A learned Wiener filter ([`WienerFilter`]) the network corrects
     /// instead of a classical one (same rule as `base_filter`, which is then
     /// `None`); its numbers are stored in the model's file with the
     /// network's weights.
@@ -70,7 +70,7 @@ pub struct ModelDescription {
 
 impl ModelDescription {
     /// Whether the network also reads its Wiener filter's output and noise
-    /// level ([`TrainOptions::base_input`]): it has inputs beyond the
+    /// level ([`crate::TrainOptions::base_input`]): it has inputs beyond the
     /// features.
     pub fn base_input(&self) -> bool {
         self.network.extra_inputs > 0

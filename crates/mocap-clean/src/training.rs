@@ -75,7 +75,7 @@ pub struct TrainOptions {
     /// the filter estimated (in units of 10 degrees, the report's largest noise; constant
     /// along the window; only a Wiener filter estimates one, so this needs
     /// `base_wiener`), after the noisy features, and its correction is
-    /// multiplied by that level (see [`crate::model`]).
+    /// multiplied by that level (see [`crate::DenoiserConfig::extra_inputs`]).
     ///
     /// Without them the network sees only the noisy window, so it cannot
     /// tell what the filter (which sees the whole take) already did, nor how

@@ -63,9 +63,8 @@ fn clean_with_the_shipped_model_keeps_the_layout_denoises_and_leaves_a_clean_tak
     let dir = tempfile::tempdir().unwrap();
     let input = sample("dataset-1_walk_normal_001.bvh");
     let original = read_bvh(Path::new(&input)).unwrap();
-    // The bundled walk is clean: the model leaves it alone. Measured 0.00
-    // degrees; 0.04 before session 23, when the noise level was pooled over
-    // the take's segments and its grid began at 0.05 degrees.
+    // The bundled walk is clean: the model leaves it alone (measured: 0.00
+    // degrees; with the level pooled over the take's segments, 0.04).
     let output = dir.path().join("clean.bvh");
     let out = mocap(&["clean", "apply", &input, "-o", path(&output), "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
