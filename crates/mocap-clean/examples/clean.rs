@@ -1,13 +1,12 @@
-//! Cleans one BVH take: the library call behind `mocap clean IN -o OUT`.
+//! Cleans one BVH take: the library call behind `mocap clean apply IN -o OUT`.
 //!
 //! cargo run --release -p mocap-clean --example clean -- IN.bvh OUT.bvh \
 //!     [--model FILE.safetensors | --filter butterworth:2:6 | savitzky-golay:9:2 | median:9 | one-euro:1:0.05:1] \
-//!     [--device cpu|cuda] [--hop N] [--spike-model DETECTOR.safetensors]
+//!     [--device cpu|cuda] [--hop N]
 
 use std::path::PathBuf;
 
-use mocap_clean::filters::Filter;
-use mocap_clean::infer::{clean_file, CleanOptions, FindSpikes, Method};
+use mocap_clean::{clean_file, CleanOptions, Filter, Method};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -24,7 +23,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         device: Default::default(),
         hop: None,
         despike: None,
-        find_spikes: None,
     };
     let mut i = 2;
     while i < args.len() {
@@ -36,12 +34,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--filter" => options.method = Method::Filter(value.parse::<Filter>()?),
             "--device" => options.device = value.parse()?,
             "--hop" => options.hop = Some(value.parse()?),
-            "--spike-model" => {
-                options.find_spikes = Some(FindSpikes {
-                    model: PathBuf::from(value),
-                    options: Default::default(),
-                })
-            }
             other => return Err(format!("unknown option {other}").into()),
         }
         i += 2;

@@ -3,11 +3,11 @@
 //! cargo run --release -p mocap-clean --example clean_eval -- --data ../shared/data/bandai \
 //!     [--model LABEL=FILE (LABEL without "=")]... [--no-default-model] [--no-filters] [--all-takes] \
 //!     [--max-takes N] [--tune-takes N] [--spike-lengths 2,4,8,16,32,64] [--seed S] [--max-sigma DEG] [--noise-above-pelvis] [--despike] \
-//!     [--spike-model [LABEL=]FILE] [--json OUT.json] [--markdown OUT.md]
+//!     [--json OUT.json] [--markdown OUT.md]
 
 use std::path::PathBuf;
 
-use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
+use mocap_clean::{evaluate, EvalOptions, ModelEntry};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut o = EvalOptions::default();
@@ -27,14 +27,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let v = value()?;
                 let (label, path) = v.split_once('=').unwrap_or((v.as_str(), v.as_str()));
                 o.models.push(ModelEntry {
-                    label: label.into(),
-                    path: Some(PathBuf::from(path)),
-                });
-            }
-            "--spike-model" => {
-                let v = value()?;
-                let (label, path) = v.split_once('=').unwrap_or(("spike detector", v.as_str()));
-                o.spike_detector = Some(ModelEntry {
                     label: label.into(),
                     path: Some(PathBuf::from(path)),
                 });

@@ -17,10 +17,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use mocap_clean::dataset::list_bvh;
-use mocap_clean::infer::{CleanModel, ModelFile};
-use mocap_clean::training::{train, TrainOptions};
-use mocap_clean::wiener::LevelEstimate;
+use mocap_clean::{list_bvh, train, CleanModel, LevelEstimate, ModelFile, TrainOptions};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::Motion;
 

@@ -6,12 +6,11 @@
 //!     [--loss derivative|mse] [--representation rot6d|expmap|euler] [--rotations local|pelvis] [--base-filter SPEC | --base-wiener FILE] [--base-context FRAMES] [--base-input] \
 //!     [--width 64] [--levels 2] [--blocks 1] [--window 16] [--large] \
 //!     [--max-sigma 10] [--spike-probability 0.5] [--max-spikes 3] [--spike-sigma 16] \
-//!     [--position-weight W] [--max-train-takes N] [--state DIR] [--resume] [--spike-detector] [--device cpu|cuda] [--json REPORT.json]
+//!     [--position-weight W] [--max-train-takes N] [--state DIR] [--resume] [--device cpu|cuda] [--json REPORT.json]
 
 use std::path::PathBuf;
 
-use mocap_clean::model::DenoiserConfig;
-use mocap_clean::training::{train, TrainOptions};
+use mocap_clean::{train, DenoiserConfig, TrainOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut o = TrainOptions::default();
@@ -67,7 +66,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--state" => o.state_dir = Some(PathBuf::from(next(&mut i)?)),
             "--plot" => o.plot = Some(PathBuf::from(next(&mut i)?)),
             "--resume" => o.resume = true,
-            "--spike-detector" => o.spike_detector = true,
             "--device" => o.device = next(&mut i)?.parse()?,
             "--json" => json = Some(PathBuf::from(next(&mut i)?)),
             other => return Err(format!("unknown option {other}").into()),

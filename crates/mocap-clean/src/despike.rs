@@ -44,7 +44,7 @@
 //! first frame after it. Long spikes are bridged with a straight path, which
 //! loses whatever the joint really did meanwhile, but it is much closer than
 //! another person's motion.
-//! `mocap clean --despike` does this before a filter or a denoiser runs,
+//! `mocap clean apply --despike` does this before a filter or a denoiser runs,
 //! which would smear each spike's jumps over the frames around it and take
 //! part of it for noise (bench/results/clean.md).
 
@@ -65,7 +65,7 @@ pub struct DespikeOptions {
     /// Jumps of global rotations (forward kinematics) instead of local ones.
     /// Noise of IK on keypoints errs on the local rotations by several times
     /// its level (a joint swings to keep its child near the keypoint,
-    /// [`crate::noise`]) but on the global ones by about its level, while a
+    /// [`crate::RandomNoise`]) but on the global ones by about its level, while a
     /// spike turns its whole subtree in both: spike boundaries stand out far
     /// better in global rotations (bench/results/clean.md).
     #[serde(default)]
@@ -75,8 +75,8 @@ pub struct DespikeOptions {
     /// also by its own. A spike there swaps several limbs, which jump, but
     /// the trunk joint itself often turns little: both the take and the
     /// motion it was swapped with stand upright (bench/results/clean.md,
-    /// "Spikes of the trunk"). On by default since session 22; settings
-    /// written before then read it as off, which is how they ran.
+    /// "Spikes of the trunk"). On by default; settings written without it
+    /// read it as off, which is how they ran.
     #[serde(default)]
     pub trunk_by_subtree: bool,
 }

@@ -13,14 +13,9 @@
 //! search for the lowest rotation error) and then run on the evaluation
 //! takes with those settings.
 //!
-//! With [`EvalOptions::spike_detector`], the learned spike detector
-//! ([`crate::spikes`]) runs alone and before the first filter and every
-//! model (rows `DETECTOR` and `DETECTOR + METHOD`): it looks for spikes in
-//! the noisy input, before anything smooths their ends.
-//!
 //! With [`EvalOptions::despike`], every method is also preceded by spike
 //! finding ([`crate::despike`]; rows `despike + METHOD`, and `despike` alone),
-//! as `mocap clean --despike` does: spikes are looked for in the noisy input
+//! as `mocap clean apply --despike` does: spikes are looked for in the noisy input
 //! and bridged, then the method runs. Its settings (threshold, span, global
 //! or local rotations) are tuned per method the same way, on the spike
 //! condition, by running the whole pipeline.
@@ -29,7 +24,7 @@ use std::path::PathBuf;
 use std::rc::Rc;
 
 use mocap_core::rotation::angle_between;
-use mocap_core::{forward_kinematics, metrics, Motion};
+use mocap_core::{metrics, Motion};
 use mocap_nn::device::DeviceChoice;
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
@@ -40,26 +35,10 @@ use crate::dataset::{
 };
 use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
-use crate::infer::{CleanModel, ModelFile};
+use crate::metrics::{position_errors, rotation_error_deg};
+use crate::model_file::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
-use crate::spikes::{SpikeDetector, SpikeOptions};
 use crate::{CleanError, Result};
-
-/// Mean geodesic angle (degrees) between the local rotations of two
-/// motions on the same skeleton (`mocap_core::metrics`).
-pub fn rotation_error_deg(a: &Motion, b: &Motion) -> f64 {
-    metrics::mean_rotation_error_degrees(a, b).map_or(f64::NAN, |e| e as f64)
-}
-
-/// Mean per-joint position error and acceleration error (units per frame^2)
-/// after forward kinematics (`mocap_core::metrics`); NaN for takes too short.
-pub fn position_errors(a: &Motion, b: &Motion) -> (f64, f64) {
-    let (pa, pb) = (forward_kinematics(a), forward_kinematics(b));
-    let position =
-        metrics::mean_joint_position_error(&pa, &pb, None).map_or(f64::NAN, |e| e as f64);
-    let acceleration = metrics::acceleration_error(&pa, &pb, None).map_or(f64::NAN, |e| e as f64);
-    (position, acceleration)
-}
 
 /// Whether `motion` is long enough for an acceleration error.
 fn has_acceleration(motion: &Motion) -> bool {
@@ -81,6 +60,40 @@ pub struct MethodMetrics {
 pub struct ModelEntry {
     pub label: String,
     pub path: Option<PathBuf>,
+}
+
+impl std::str::FromStr for ModelEntry {
+    type Err = String;
+
+    /// `LABEL=FILE`, or `FILE` (labelled by itself).
+    fn from_str(text: &str) -> std::result::Result<Self, Self::Err> {
+        let (label, path) = text.split_once('=').unwrap_or((text, text));
+        if path.is_empty() {
+            return Err(format!("{text:?}: expected LABEL=FILE or FILE"));
+        }
+        Ok(ModelEntry {
+            label: label.into(),
+            path: Some(PathBuf::from(path)),
+        })
+    }
+}
+
+/// Spike lengths of the spike-survival study written as `2,4,8` (frames),
+/// or `none` for no study.
+pub fn parse_spike_lengths(text: &str) -> std::result::Result<Vec<usize>, String> {
+    if text.trim() == "none" {
+        return Ok(Vec::new());
+    }
+    text.split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| match s.trim().parse::<usize>() {
+            Ok(0) => Err(format!("{text:?}: a spike lasts at least one frame")),
+            Ok(n) => Ok(n),
+            Err(_) => Err(format!(
+                "{text:?}: expected frame counts like 2,4,8 or none"
+            )),
+        })
+        .collect()
 }
 
 /// Options of `mocap clean eval`.
@@ -108,11 +121,6 @@ pub struct EvalOptions {
     /// takes (see the module docs).
     #[serde(default)]
     pub despike: bool,
-    /// Also run this learned spike detector alone and before the first
-    /// filter and every model (see the module docs; `path` is required:
-    /// no detector ships).
-    #[serde(default)]
-    pub spike_detector: Option<ModelEntry>,
     pub seed: u64,
     pub device: DeviceChoice,
 }
@@ -134,7 +142,6 @@ impl Default for EvalOptions {
             spikes: SpikeNoise::default(),
             spike_lengths: vec![2, 4, 8, 16, 32, 64],
             despike: false,
-            spike_detector: None,
             seed: 7,
             device: DeviceChoice::Cpu,
         }
@@ -333,9 +340,6 @@ enum Cleaner {
     Filter(Filter),
     /// A network or a Wiener filter.
     Model(Rc<ModelFile>),
-    Spikes(Rc<SpikeDetector>),
-    /// The first, then the second on its output.
-    Then(Box<Cleaner>, Box<Cleaner>),
 }
 
 impl Cleaner {
@@ -343,32 +347,16 @@ impl Cleaner {
         match self {
             Cleaner::Filter(f) => filter_motion(noisy, f),
             Cleaner::Model(m) => Ok(m.clean(noisy, None)?.0),
-            Cleaner::Spikes(d) => Ok(d.remove_spikes(noisy, &SpikeOptions::default())?.0),
-            Cleaner::Then(first, second) => second.run(&first.run(noisy)?),
         }
     }
 }
 
-/// The cleaners of a condition: its tuned filters, the models, then the
-/// spike detector's rows (alone, then before the first filter, the best
-/// family, Butterworth, and before every model).
+/// The cleaners of a condition: its tuned filters, then the models.
 fn cleaners_for(
     filters: &[(String, Cleaner)],
     models: &[(String, Cleaner)],
-    detector: Option<&(String, Rc<SpikeDetector>)>,
 ) -> Vec<(String, Cleaner)> {
-    let mut rows: Vec<_> = filters.iter().chain(models).cloned().collect();
-    if let Some((label, d)) = detector {
-        let spikes = Cleaner::Spikes(d.clone());
-        rows.push((label.clone(), spikes.clone()));
-        for (name, c) in filters.iter().take(1).chain(models) {
-            rows.push((
-                format!("{label} + {name}"),
-                Cleaner::Then(Box::new(spikes.clone()), Box::new(c.clone())),
-            ));
-        }
-    }
-    rows
+    filters.iter().chain(models).cloned().collect()
 }
 
 /// A method of the evaluation: a cleaner's output (`None`: the noisy input
@@ -393,7 +381,7 @@ fn run_methods(
         .collect::<Result<_>>()?;
     for (k, method) in methods.iter().enumerate() {
         match (&method.despike, method.cleaner) {
-            // As `mocap clean --despike` does: spikes bridged first.
+            // As `mocap clean apply --despike` does: spikes bridged first.
             (Some(d), cleaner) => {
                 let bridged = remove_spikes(noisy, d).0;
                 match cleaner {
@@ -477,6 +465,13 @@ fn refuse_other_rigs(model: &ModelFile, entry: &ModelEntry, takes: &[Take]) -> R
 
 /// Runs the evaluation.
 pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
+    if options.models.is_empty() && !options.filters {
+        return Err(CleanError::Invalid(
+            "nothing to evaluate: no model and no filters (--no-default-model and --no-filters \
+             with no --model)"
+                .into(),
+        ));
+    }
     let paths = list_bvh(&options.inputs)?;
     let (mut eval_paths, tune_paths) = if options.test_split_only {
         (
@@ -504,20 +499,6 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         refuse_other_rigs(&model, m, &takes)?;
         models.push((m.label.clone(), Cleaner::Model(Rc::new(model))));
     }
-    let detector = match &options.spike_detector {
-        Some(entry) => Some((
-            entry.label.clone(),
-            Rc::new(match &entry.path {
-                Some(p) => SpikeDetector::load(p, options.device)?,
-                None => {
-                    return Err(CleanError::Invalid(
-                        "the spike detector needs a model file (none ships)".into(),
-                    ))
-                }
-            }),
-        )),
-        None => None,
-    };
     let mut tuned_filters = Vec::new();
     let mut per_condition: Vec<Vec<(String, Cleaner)>> = Vec::new();
     let tune_takes = if options.filters || options.despike {
@@ -599,7 +580,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
 
     let mut entries = Vec::new();
     for (condition, filters) in per_condition.iter().enumerate() {
-        let owned = cleaners_for(filters, &models, detector.as_ref());
+        let owned = cleaners_for(filters, &models);
         let cleaners: Vec<_> = owned.iter().collect();
         let methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
         // Frame-weighted sums of the three metrics and the frames each was
@@ -658,7 +639,7 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
     // the filters are those tuned for spikes alone.
     let mut spike_survival = Vec::new();
     let spike_filters = per_condition.get(SPIKES_ONLY).map_or(&[][..], |f| &f[..]);
-    let owned = cleaners_for(spike_filters, &models, detector.as_ref());
+    let owned = cleaners_for(spike_filters, &models);
     let cleaners: Vec<_> = owned.iter().collect();
     let spike_methods = methods(&cleaners, options, &tune_takes, &mut tuned_despike)?;
     for &length in &options.spike_lengths {

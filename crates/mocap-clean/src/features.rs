@@ -91,7 +91,7 @@ pub enum RotationFrame {
     ///
     /// Why: markerless capture errs on each keypoint on its own, so its
     /// rotation errors are independent per joint in *global* terms, and the
-    /// chain-corrected noise ([`crate::noise`]) is built that way. In local
+    /// chain-corrected noise ([`crate::RandomNoise`]) is built that way. In local
     /// terms each joint's error also carries its parent's error, undone: the
     /// errors of parent and child compensate each other, and a network that
     /// reduces them one joint at a time breaks the compensation, so the

@@ -34,7 +34,7 @@ pub enum Filter {
     /// backward, so the effective order doubles) with cutoff in Hz.
     Butterworth { order: usize, cutoff_hz: f32 },
     /// Zero-phase Butterworth low-pass of `order` whose cutoff is chosen for
-    /// each channel of each take among [`GCV_CUTOFFS_HZ`] by generalised
+    /// each channel of each take among 0.5-12 Hz (14 cutoffs) by generalised
     /// cross-validation (see [`gcv_trace_fraction`]).
     ButterworthGcv { order: usize },
     /// Savitzky-Golay smoothing over an odd `window` of frames with a

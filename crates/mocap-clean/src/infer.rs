@@ -13,186 +13,23 @@
 //! layout and root translation.
 
 use std::borrow::Cow;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-use burn::module::Module;
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Tensor, TensorData};
 use mocap_core::io::bvh::write_bvh;
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
-};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
-use crate::features::FeatureLayout;
 use crate::filters::{filter_motion, Filter};
-use crate::model::{Denoiser, Head};
-use crate::spikes::{SpikeDetector, SpikeOptions};
-use crate::training::{
-    base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
-    CHECKPOINT_KIND_VERSION,
-};
-use crate::wiener::{LevelEstimate, WienerFilter, WienerOutcome, WIENER_KIND};
+use crate::metrics::rotation_error_deg;
+use crate::model_file::{window_base, with_base_input, Base, CleanModel, ModelFile};
+use crate::wiener::WienerOutcome;
 use crate::{CleanError, Result};
 
-/// Where the shipped default model lives in the source tree.
-pub const DEFAULT_MODEL_PATH: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../models/clean-default.safetensors"
-);
-
-/// The shipped default model's bytes, compiled in.
-pub static DEFAULT_MODEL: &[u8] = include_bytes!("../../../models/clean-default.safetensors");
-
-/// A trained denoiser ready to clean takes.
-pub struct CleanModel {
-    pub description: ModelDescription,
-    /// Where it was loaded from.
-    pub source: PathBuf,
-    model: Denoiser,
-    device: Device,
-    /// The learned filter the network corrects
-    /// ([`ModelDescription::base_wiener`]).
-    base_wiener: Option<WienerFilter>,
-}
-
-impl std::fmt::Debug for CleanModel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CleanModel")
-            .field("description", &self.description)
-            .field("source", &self.source)
-            .finish_non_exhaustive()
-    }
-}
-
 impl CleanModel {
-    /// Loads a model file written by training.
-    pub fn load(path: &Path, device: DeviceChoice) -> Result<CleanModel> {
-        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
-        Self::from_bytes(bytes, path, device)
-    }
-
-    /// The shipped default model, or the file named by the
-    /// `MOCAP_CLEAN_MODEL` environment variable. The default model
-    /// (`models/clean-default.safetensors`, about 20 MB with the Wiener mixture it corrects) is compiled into the
-    /// binary, so it works wherever the binary is installed.
-    pub fn load_default(device: DeviceChoice) -> Result<CleanModel> {
-        if let Some(path) = std::env::var_os("MOCAP_CLEAN_MODEL") {
-            return Self::load(Path::new(&path), device);
-        }
-        // Named as the style crate names its built-in model: the build
-        // machine's source path means nothing where the binary runs.
-        Self::from_bytes(
-            DEFAULT_MODEL.to_vec(),
-            Path::new("<built-in models/clean-default.safetensors>"),
-            device,
-        )
-    }
-
-    /// Loads checkpoint bytes; `origin` names them in errors.
-    pub fn from_bytes(bytes: Vec<u8>, origin: &Path, device: DeviceChoice) -> Result<CleanModel> {
-        let header = header_from_bytes(&bytes, origin)?;
-        let bad = |m: String| CleanError::Invalid(format!("{}: {m}", origin.display()));
-        header.expect_kind(
-            origin,
-            CHECKPOINT_KIND,
-            CHECKPOINT_KIND_VERSION,
-            "a denoiser",
-        )?;
-        let description: ModelDescription = serde_json::from_value(header.config)
-            .map_err(|e| bad(format!("bad model description: {e}")))?;
-        // A network reading more than its features reads its Wiener filter's
-        // output and noise level, and only a Wiener filter estimates one.
-        let extra = description.network.extra_inputs;
-        let expected = base_input_channels(description.network.channels);
-        if extra > 0 && (extra != expected || description.base_wiener.is_none()) {
-            return Err(bad(format!(
-                "the network reads {extra} inputs besides its features; a model reading its base \
-                 reads {expected}, and needs a base Wiener filter{}",
-                if description.base_wiener.is_some() {
-                    ""
-                } else {
-                    " (it has none)"
-                }
-            )));
-        }
-        let device = device.device()?;
-        let mut model = description.network.init(&device)?;
-        if let Some(wiener) = &description.base_wiener {
-            WienerFilter::check_description(wiener).map_err(bad)?;
-            if description.base_filter.is_some() {
-                return Err(bad("a base filter and a base Wiener filter at once".into()));
-            }
-            model.base = Some(WienerFilter::empty_tensors(wiener));
-        }
-        let mut model = load_weights_from_bytes(bytes, origin, model)?;
-        let base_wiener = match (model.base.take(), &description.base_wiener) {
-            (Some(tensors), Some(wiener)) => {
-                Some(WienerFilter::from_tensors(wiener.clone(), tensors).map_err(bad)?)
-            }
-            _ => None,
-        };
-        Ok(CleanModel {
-            description,
-            source: origin.to_path_buf(),
-            model,
-            device,
-            base_wiener,
-        })
-    }
-
-    /// The network and the device it runs on (the spike detector of
-    /// [`crate::spikes`] runs it on its own).
-    pub(crate) fn network(&self) -> (&Denoiser, &Device) {
-        (&self.model, &self.device)
-    }
-
-    /// The features of `motion`'s rig, or an error when the model was
-    /// trained on another rig.
-    pub(crate) fn layout_for(&self, motion: &Motion) -> Result<FeatureLayout> {
-        let layout = FeatureLayout::new(motion.skeleton(), self.description.representation)?
-            .in_frame(self.description.frame)?;
-        let c = layout.channels();
-        if c != self.description.network.channels {
-            return Err(CleanError::Invalid(format!(
-                "the model was trained on a rig of {} joints with rotations ({}, ...), this take \
-                 has {} ({c} features against {}): clean it with --filter butterworth-gcv:2, or \
-                 train a model on this rig with `mocap clean train` (played by the model's rig \
-                 through retargeting, takes of other rigs came out worse than with that filter: \
-                 bench/results/clean.md, \"Takes of other rigs\")",
-                self.description.joints.len(),
-                self.description.joints[..self.description.joints.len().min(3)].join(", "),
-                layout.joints.len(),
-                self.description.network.channels,
-            )));
-        }
-        // As many joints is not the same rig: the network reads each
-        // joint's features in its place, so they must be the same joints
-        // in the same order.
-        let names = layout.joint_names(motion.skeleton());
-        let known = &self.description.joints;
-        if let Some(k) = (0..names.len()).find(|&k| known.get(k) != Some(&names[k])) {
-            return Err(CleanError::Invalid(format!(
-                "the model was trained on a rig of {} joints with rotations ({}, ...), this take's \
-                 {} joints with rotations are others: joint {} is {:?} where the model has {:?}. \
-                 Clean it with --filter butterworth-gcv:2, play it by the model's rig first \
-                 (`mocap convert IN OUT --retarget-to samples/dataset-1_walk_normal_001.bvh`, \
-                 with --rig FILE for joint names of its own), or train a model on this rig with \
-                 `mocap clean train`",
-                known.len(),
-                known[..known.len().min(3)].join(", "),
-                names.len(),
-                k + 1,
-                names[k],
-                known.get(k).map_or("", String::as_str),
-            )));
-        }
-        Ok(layout)
-    }
-
     /// Cleans a whole take (see the module docs). `hop` defaults to `T / 4`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<Motion> {
         Ok(self.clean_reporting(motion, hop)?.0)
@@ -200,7 +37,7 @@ impl CleanModel {
 
     /// [`CleanModel::clean`], also returning the noise level (degrees) its
     /// Wiener filter estimated for the take, when it corrects one
-    /// ([`ModelDescription::base_wiener`]) and that filter sees the whole take.
+    /// ([`crate::ModelDescription::base_wiener`]) and that filter sees the whole take.
     pub fn clean_reporting(
         &self,
         motion: &Motion,
@@ -230,13 +67,6 @@ impl CleanModel {
         hop: Option<usize>,
         level_deg: Option<f64>,
     ) -> Result<(Motion, Option<WienerOutcome>)> {
-        if self.description.network.head != Head::Correction {
-            return Err(CleanError::Invalid(format!(
-                "{} is a spike detector (`mocap clean train --spike-detector`), not a denoiser: \
-                 give it with --spike-model",
-                self.source.display()
-            )));
-        }
         let layout = self.layout_for(motion)?;
         let c = layout.channels();
         let ci = self.description.network.input_channels();
@@ -366,85 +196,9 @@ impl CleanModel {
         layout.decode_into(&cleaned, &mut out);
         Ok((out, outcome))
     }
-
-    /// The learned filter the network corrects, if it corrects one
-    /// ([`ModelDescription::base_wiener`]).
-    pub fn base_wiener(&self) -> Option<&WienerFilter> {
-        self.base_wiener.as_ref()
-    }
-
-    /// Sets how the Wiener filter the network corrects estimates a take's
-    /// noise level (nothing to set for a model without one).
-    pub fn set_level_estimate(&mut self, estimate: LevelEstimate) {
-        if let Some(wiener) = &mut self.base_wiener {
-            wiener.set_level_estimate(estimate);
-        }
-    }
-
-    /// The same network correcting another Wiener filter: one with the same
-    /// rig, segment and noise covariance as its own (e.g. a mixture made from
-    /// it by [`crate::wiener::fit_mixture`]), so the noise level it reads
-    /// means the same. The network is not retrained.
-    pub fn with_base_wiener(mut self, wiener: WienerFilter) -> Result<CleanModel> {
-        let own = self.base_wiener.as_ref().ok_or_else(|| {
-            CleanError::Invalid("this model corrects no Wiener filter to replace".into())
-        })?;
-        if !own.same_noise_model(&wiener) {
-            return Err(CleanError::Invalid(
-                "the new Wiener filter differs from the model's in rig, segment or noise \
-                 covariance"
-                    .into(),
-            ));
-        }
-        self.description.base_wiener = Some(wiener.description.clone());
-        self.base_wiener = Some(wiener);
-        Ok(self)
-    }
-
-    /// Writes the model (the network and the Wiener filter it corrects) to
-    /// `path`, atomically, with `data` and `training` in its header (e.g.
-    /// those of the file it was loaded from, [`CleanModel::header_of`]).
-    pub fn save(
-        &self,
-        path: &Path,
-        data: serde_json::Value,
-        training: serde_json::Value,
-    ) -> Result<()> {
-        let mut module = self.model.clone();
-        module.base = self.base_wiener.as_ref().map(WienerFilter::to_tensors);
-        let header = CheckpointHeader {
-            kind: CHECKPOINT_KIND.into(),
-            kind_version: CHECKPOINT_KIND_VERSION,
-            config: serde_json::to_value(&self.description)
-                .map_err(|e| CleanError::Invalid(format!("describing the model: {e}")))?,
-            data,
-            training,
-        };
-        save_weights(path, &module, &header)?;
-        Ok(())
-    }
-
-    /// The `data` and `training` records of a model file's header.
-    pub fn header_of(path: &Path) -> Result<(serde_json::Value, serde_json::Value)> {
-        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
-        let header = header_from_bytes(&bytes, path)?;
-        Ok((header.data, header.training))
-    }
-
-    /// Zeroes the network's output layer, so that the model gives its base
-    /// filter's output (tests of what is around the network).
-    #[cfg(test)]
-    pub(crate) fn zero_output(&mut self) {
-        self.model.zero_output();
-    }
-
-    /// Number of trainable numbers of the network.
-    pub fn parameter_count(&self) -> usize {
-        self.model.num_params()
-    }
 }
 
-/// How `mocap clean IN -o OUT` cleans.
+/// How `mocap clean apply IN -o OUT` cleans.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum Method {
     /// The shipped default model.
@@ -459,34 +213,7 @@ pub enum Method {
     SpikesOnly,
 }
 
-/// A file written by `mocap clean train`: a network, or a Wiener filter
-/// (`--wiener`), told apart by the kind in its header.
-pub enum ModelFile {
-    Network(Box<CleanModel>),
-    Wiener(WienerFilter),
-}
-
 impl ModelFile {
-    pub fn load(path: &Path, device: DeviceChoice) -> Result<ModelFile> {
-        let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
-        if header_from_bytes(&bytes, path)?.kind == WIENER_KIND {
-            Ok(ModelFile::Wiener(WienerFilter::from_bytes(bytes, path)?))
-        } else {
-            Ok(ModelFile::Network(Box::new(CleanModel::from_bytes(
-                bytes, path, device,
-            )?)))
-        }
-    }
-
-    /// `Ok` when this model can clean `motion` (it was trained or fitted on
-    /// `motion`'s rig), else the error [`ModelFile::clean`] would give.
-    pub fn check_rig(&self, motion: &Motion) -> Result<()> {
-        match self {
-            ModelFile::Network(model) => model.layout_for(motion).map(|_| ()),
-            ModelFile::Wiener(filter) => filter.layout_for(motion).map(|_| ()),
-        }
-    }
-
     /// Cleans `motion` (`hop`: see [`CleanModel::clean`]); also says what
     /// ran, e.g. `Wiener filter (sigma 4.2 deg)`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<(Motion, String)> {
@@ -510,7 +237,7 @@ impl ModelFile {
     }
 }
 
-/// Options of `mocap clean IN -o OUT`.
+/// Options of `mocap clean apply IN -o OUT`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CleanOptions {
     pub input: PathBuf,
@@ -520,25 +247,12 @@ pub struct CleanOptions {
     /// Frames between window starts (default: a quarter window).
     pub hop: Option<usize>,
     /// Look for spikes in the input and bridge them before cleaning
-    /// ([`crate::despike`]).
+    /// ([`crate::remove_spikes`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
-    /// Find spikes with the learned detector *before* cleaning and bridge
-    /// them ([`crate::spikes`]).
-    #[serde(default)]
-    pub find_spikes: Option<FindSpikes>,
 }
 
-/// Learned spike finding before cleaning.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct FindSpikes {
-    /// A detector written by `mocap clean train --spike-detector` (none
-    /// ships: see [`crate::spikes`] for what one trained here does).
-    pub model: PathBuf,
-    pub options: SpikeOptions,
-}
-
-/// What `mocap clean IN -o OUT` reports.
+/// What `mocap clean apply IN -o OUT` reports.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CleanReport {
     pub input: PathBuf,
@@ -553,10 +267,6 @@ pub struct CleanReport {
     /// The spikes found and bridged (with `despike`).
     #[serde(default)]
     pub spikes: Vec<BridgedSpike>,
-    /// The spikes the learned detector found and bridged before cleaning
-    /// (with `find_spikes`): the top joint of each marked subtree.
-    #[serde(default)]
-    pub detected_spikes: Vec<BridgedSpike>,
 }
 
 /// A spike that was bridged, as reported: its joint by name (the joints
@@ -594,7 +304,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
     };
     let start = Instant::now();
     // The take the method cleans: the input, or its copy with the spikes
-    // found (by rules, then by the learned detector) bridged.
+    // found bridged.
     let (motion, spikes) = match &options.despike {
         Some(despike) => {
             let (bridged, found) = remove_spikes(&original, despike);
@@ -602,23 +312,12 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         }
         None => (Cow::Borrowed(&original), Vec::new()),
     };
-    let (motion, detected_spikes) = match &options.find_spikes {
-        Some(find) => {
-            let detector = SpikeDetector::load(&find.model, options.device)?;
-            let (bridged, found) = detector
-                .remove_spikes(&motion, &find.options)
-                .map_err(in_file)?;
-            (Cow::Owned(bridged), found)
-        }
-        None => (motion, Vec::new()),
-    };
     let detect_seconds = start.elapsed().as_secs_f64();
     let (cleaned, method, seconds) = match &options.method {
         Method::SpikesOnly => {
-            if options.despike.is_none() && options.find_spikes.is_none() {
+            if options.despike.is_none() {
                 return Err(CleanError::Invalid(
-                    "spike finding only, but no spike finding asked for (despike or a spike model)"
-                        .into(),
+                    "spike finding only, but no spike finding asked for (despike)".into(),
                 ));
             }
             (
@@ -651,12 +350,6 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         }
     };
     write_bvh(&options.output, &cleaned)?;
-    let reported = |spikes: &[FoundSpike]| -> Vec<BridgedSpike> {
-        spikes
-            .iter()
-            .map(|s| BridgedSpike::new(&original, s))
-            .collect()
-    };
     let frames = motion.frame_count();
     let seconds = seconds + detect_seconds;
     Ok(CleanReport {
@@ -666,19 +359,25 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         frames,
         seconds,
         frames_per_second: frames as f64 / seconds.max(1e-9),
-        mean_change_deg: crate::eval::rotation_error_deg(&original, &cleaned),
-        spikes: reported(&spikes),
-        detected_spikes: reported(&detected_spikes),
+        mean_change_deg: rotation_error_deg(&original, &cleaned),
+        spikes: spikes
+            .iter()
+            .map(|s| BridgedSpike::new(&original, s))
+            .collect(),
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
+
     use crate::despike::bridge_spikes;
     use crate::features::Representation;
-    use crate::model::DenoiserConfig;
+    use crate::model::{Denoiser, DenoiserConfig};
+    use crate::model_file::{ModelDescription, CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION};
     use crate::test_support::synthetic_motion;
+    use burn::tensor::Device;
     use mocap_core::io::bvh::read_bvh;
     use mocap_nn::checkpoint::{weights_to_bytes, CheckpointHeader};
 
@@ -751,14 +450,14 @@ mod tests {
         let (with_context, noise) = cleaned_by(&description);
         // A classical base estimates no noise level.
         assert_eq!(noise, None);
-        let off = crate::eval::rotation_error_deg(&whole_take, &with_context);
+        let off = crate::metrics::rotation_error_deg(&whole_take, &with_context);
         assert!(off < 1e-3, "{off} degrees from the whole-take filter");
         for f in 0..noisy.frame_count() {
             assert_eq!(with_context.root_translation(f), noisy.root_translation(f));
         }
         description.base_context = 0;
         let (per_window, _) = cleaned_by(&description);
-        let off = crate::eval::rotation_error_deg(&whole_take, &per_window);
+        let off = crate::metrics::rotation_error_deg(&whole_take, &per_window);
         assert!(off > 0.05, "per-window filtering is only {off} degrees off");
     }
 
@@ -788,8 +487,8 @@ mod tests {
         let motion = synthetic_motion(120, 5);
         let a = model.clean(&motion, Some(4)).unwrap();
         let b = model.clean(&motion, Some(2)).unwrap();
-        let diff = crate::eval::rotation_error_deg(&a, &b);
-        let change = crate::eval::rotation_error_deg(&motion, &a);
+        let diff = crate::metrics::rotation_error_deg(&a, &b);
+        let change = crate::metrics::rotation_error_deg(&motion, &a);
         assert!(
             diff < 0.25 * change.max(0.1),
             "hop changes the result by {diff} (model changes {change})"
@@ -828,7 +527,6 @@ mod tests {
             device: DeviceChoice::Cpu,
             hop: None,
             despike: Some(despike),
-            find_spikes: None,
         })
         .unwrap();
         assert_eq!(report.spikes.len(), 1, "{:?}", report.spikes);
@@ -849,10 +547,10 @@ mod tests {
         }];
         let written = read_bvh(&output).unwrap();
         let (again, _) = wiener.clean(&bridge_spikes(&spiked, &found), None).unwrap();
-        assert!(crate::eval::rotation_error_deg(&again, &written) < 1e-3);
+        assert!(crate::metrics::rotation_error_deg(&again, &written) < 1e-3);
         let (first, _) = wiener.clean(&spiked, None).unwrap();
         let bridged_after = bridge_spikes(&first, &found);
-        assert!(crate::eval::rotation_error_deg(&bridged_after, &written) > 0.01);
+        assert!(crate::metrics::rotation_error_deg(&bridged_after, &written) > 0.01);
     }
 
     #[test]

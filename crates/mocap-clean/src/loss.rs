@@ -10,7 +10,6 @@
 //! with `alpha = 1/900` and `beta = 1/810000` at 30 fps, i.e. `alpha = dt^2`
 //! and `beta = dt^4`; `(alpha, beta) = (0, 0)` is plain MSE.
 
-use burn::tensor::activation::log_sigmoid;
 use burn::tensor::Tensor;
 use serde::{Deserialize, Serialize};
 
@@ -85,15 +84,6 @@ pub fn position_loss(fk: &FkSkeleton, pred: Tensor<3>, target: Tensor<3>) -> Ten
         .mean()
 }
 
-/// Mean binary cross-entropy of logits `z` against 0/1 targets `y` (the
-/// spike detector's loss): `-(y ln sigmoid(z) + (1 - y) ln sigmoid(-z))`,
-/// with burn's numerically stable `log_sigmoid`.
-pub fn binary_cross_entropy_with_logits(z: Tensor<3>, y: Tensor<3>) -> Tensor<1> {
-    let positive = log_sigmoid(z.clone()) * y.clone();
-    let negative = log_sigmoid(z.neg()) * (y.neg() + 1.0);
-    (positive + negative).mean().neg()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,34 +102,5 @@ mod tests {
         assert!((loss - 5.5).abs() < 1e-3, "{loss}");
         let mse: f32 = derivative_loss(pred, target, &LossWeights::mse(30.0)).into_scalar();
         assert!((mse - 0.5).abs() < 1e-6);
-    }
-
-    #[test]
-    fn cross_entropy_matches_a_hand_computation() {
-        let device = Device::flex();
-        let z = Tensor::<1>::from_floats([0.0, 2.0, -3.0, 40.0], &device).reshape([1, 1, 4]);
-        let y = Tensor::<1>::from_floats([1.0, 0.0, 0.0, 1.0], &device).reshape([1, 1, 4]);
-        // -ln(sigmoid(0)) = ln 2; -ln(1 - sigmoid(2)) = ln(1 + e^2);
-        // -ln(1 - sigmoid(-3)) = ln(1 + e^-3); -ln(sigmoid(40)) ~ 0.
-        let expected = (2f32.ln() + (1.0 + 2f32.exp()).ln() + (1.0 + (-3f32).exp()).ln()) / 4.0;
-        let loss: f32 = binary_cross_entropy_with_logits(z, y).into_scalar();
-        assert!((loss - expected).abs() < 1e-5, "{loss} vs {expected}");
-    }
-
-    #[test]
-    fn cross_entropy_gradient_is_sigmoid_minus_target() {
-        let device = Device::flex().autodiff();
-        let values = [0.0f32, 2.0, -3.0, 1.5];
-        let targets = [1.0f32, 0.0, 0.0, 1.0];
-        let z = Tensor::<1>::from_floats(values, &device)
-            .reshape([1, 1, 4])
-            .require_grad();
-        let y = Tensor::<1>::from_floats(targets, &device).reshape([1, 1, 4]);
-        let grads = binary_cross_entropy_with_logits(z.clone(), y).backward();
-        let g: Vec<f32> = z.grad(&grads).unwrap().into_data().try_to_vec().unwrap();
-        for i in 0..4 {
-            let expected = (1.0 / (1.0 + (-values[i]).exp()) - targets[i]) / 4.0;
-            assert!((g[i] - expected).abs() < 1e-5, "{i}: {g:?} vs {expected}");
-        }
     }
 }

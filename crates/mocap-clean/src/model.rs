@@ -20,11 +20,6 @@
 //! the base filter's output and, last, the noise level that filter
 //! estimated). Its correction is then multiplied by that last input, so it
 //! vanishes on a take the filter found clean.
-//!
-//! The same network with another head ([`Head::SpikeLogits`]: one output per
-//! joint, no global skip) is the learned spike detector of
-//! [`crate::spikes`]: for every joint and frame, the logit of "this joint's
-//! rotation belongs to another motion here".
 
 use burn::module::Module;
 use burn::nn::conv::{Conv1d, Conv1dConfig, ConvTranspose1d, ConvTranspose1dConfig};
@@ -52,9 +47,6 @@ pub struct DenoiserConfig {
     pub kernel: usize,
     /// Frames per window (report: 16); a multiple of `2^levels`.
     pub window: usize,
-    /// What the network outputs (default: a denoised copy of its input).
-    #[serde(default)]
-    pub head: Head,
     /// Input channels after the `channels` features that the network reads
     /// but does not output or add to its output: what it is conditioned on
     /// ([`crate::training::TrainOptions::base_input`]). The last of them is a
@@ -62,17 +54,6 @@ pub struct DenoiserConfig {
     /// docs). 0 for models written before this field.
     #[serde(default)]
     pub extra_inputs: usize,
-}
-
-/// What the network outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum Head {
-    /// The input plus a learned correction (the denoiser).
-    #[default]
-    Correction,
-    /// One logit per joint and frame, without the global skip (the spike
-    /// detector of [`crate::spikes`]).
-    SpikeLogits { joints: usize },
 }
 
 impl DenoiserConfig {
@@ -85,7 +66,6 @@ impl DenoiserConfig {
             blocks: 1,
             kernel: 3,
             window: 16,
-            head: Head::Correction,
             extra_inputs: 0,
         }
     }
@@ -99,7 +79,6 @@ impl DenoiserConfig {
             blocks: 4,
             kernel: 3,
             window: 16,
-            head: Head::Correction,
             extra_inputs: 0,
         }
     }
@@ -112,12 +91,6 @@ impl DenoiserConfig {
         }
         if self.kernel.is_multiple_of(2) {
             return bad("the kernel size must be odd");
-        }
-        if self.head == (Head::SpikeLogits { joints: 0 }) {
-            return bad("a spike detector needs at least one joint");
-        }
-        if self.extra_inputs > 0 && self.head != Head::Correction {
-            return bad("only a denoiser reads inputs it does not output");
         }
         if self.levels > 6 || self.window == 0 || !self.window.is_multiple_of(1 << self.levels) {
             return bad("the window must be a positive multiple of 2^levels (levels at most 6)");
@@ -135,12 +108,9 @@ impl DenoiserConfig {
         self.channels + self.extra_inputs
     }
 
-    /// Channels of the output: the features, or one per joint.
+    /// Channels of the output: the features.
     pub fn output_channels(&self) -> usize {
-        match self.head {
-            Head::Correction => self.channels,
-            Head::SpikeLogits { joints } => joints,
-        }
+        self.channels
     }
 
     /// Builds the network with fresh weights on `device`.
@@ -184,7 +154,6 @@ impl DenoiserConfig {
             bottleneck: blocks(self.width_at(self.levels)),
             decoder,
             output: conv(self.width, self.output_channels()),
-            residual: self.head == Head::Correction,
             features: self.channels,
             base: None,
         })
@@ -239,10 +208,6 @@ pub struct Denoiser {
     bottleneck: Vec<ResBlock>,
     decoder: Vec<DecoderLevel>,
     output: Conv1d,
-    /// Whether the input is added to the output (the global skip; not for
-    /// a spike detector). Not a weight: it comes from the configuration.
-    #[module(skip)]
-    residual: bool,
     /// How many of the input's channels are features (the rest condition
     /// the network): the global skip adds those. Not a weight.
     #[module(skip)]
@@ -256,8 +221,7 @@ pub struct Denoiser {
 
 impl Denoiser {
     /// Runs a batch `[batch, channels, frames]` (`frames` a multiple of
-    /// `2^levels`): the cleaned batch, or `[batch, joints, frames]` logits
-    /// for a spike detector.
+    /// `2^levels`): the cleaned batch.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let mut h = relu(self.input.forward(x.clone()));
         let mut skips = Vec::with_capacity(self.encoder.len());
@@ -284,11 +248,7 @@ impl Denoiser {
             // The last input is the noise level: the correction scales with it.
             out = out * x.clone().narrow(1, inputs - 1, 1);
         }
-        if self.residual {
-            x.narrow(1, 0, self.features) + out
-        } else {
-            out
-        }
+        x.narrow(1, 0, self.features) + out
     }
 
     /// Zeroes the output layer: a denoiser then returns its input unchanged
@@ -315,19 +275,6 @@ mod tests {
         let model = config.init(&device).unwrap();
         let x = Tensor::<3>::zeros([2, 12, 16], &device);
         assert_eq!(model.forward(x).dims(), [2, 12, 16]);
-        assert_eq!(model.num_params(), config.parameter_count());
-    }
-
-    #[test]
-    fn a_spike_detector_has_one_output_per_joint() {
-        let device = Device::flex();
-        let config = DenoiserConfig {
-            head: Head::SpikeLogits { joints: 2 },
-            ..DenoiserConfig::small(12)
-        };
-        let model = config.init(&device).unwrap();
-        let x = Tensor::<3>::zeros([3, 12, 16], &device);
-        assert_eq!(model.forward(x).dims(), [3, 2, 16]);
         assert_eq!(model.num_params(), config.parameter_count());
     }
 
@@ -388,11 +335,6 @@ mod tests {
         let size = |v: Vec<f32>| v.iter().map(|x| x.abs()).sum::<f32>();
         assert!(size(correction(0.5)) > 0.0);
         assert!(size(correction(0.01)) < 0.1 * size(correction(0.5)));
-        let spike_detector = DenoiserConfig {
-            head: Head::SpikeLogits { joints: 2 },
-            ..config
-        };
-        assert!(spike_detector.validate().is_err());
     }
 
     #[test]

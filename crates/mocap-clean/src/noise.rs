@@ -367,27 +367,16 @@ pub fn add_noise<R: Rng + ?Sized>(
     config: &NoiseConfig,
     rng: &mut R,
 ) -> Result<Motion> {
-    Ok(add_noise_with_spikes(motion, donors, config, rng)?.0)
-}
-
-/// [`add_noise`], also returning the spikes that were added (the targets
-/// of the spike detector, [`crate::spikes`]).
-pub fn add_noise_with_spikes<R: Rng + ?Sized>(
-    motion: &Motion,
-    donors: &[&Motion],
-    config: &NoiseConfig,
-    rng: &mut R,
-) -> Result<(Motion, Vec<Spike>)> {
     let noisy = match &config.random {
         Some(r) => add_random_noise(motion, r, rng).0,
         None => motion.clone(),
     };
     if let Some(s) = &config.spikes {
         if rng.random::<f32>() < config.spike_probability {
-            return add_spike_noise(&noisy, donors, s, rng);
+            return Ok(add_spike_noise(&noisy, donors, s, rng)?.0);
         }
     }
-    Ok((noisy, Vec::new()))
+    Ok(noisy)
 }
 
 #[cfg(test)]

@@ -9,11 +9,6 @@
 //! so runs with different seeds and losses are validated on the same data.
 //! The validation loss is the plain mean squared error of the features, for
 //! every training loss, so that curves of different losses compare.
-//!
-//! With [`TrainOptions::spike_detector`] the same loop trains the learned
-//! spike detector of [`crate::spikes`] instead: the network's head gives one
-//! logit per joint and frame, the target is the mask of the spikes the noise
-//! added, and the loss (training and validation) is the binary cross-entropy.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,7 +20,7 @@ use mocap_core::Motion;
 use mocap_nn::checkpoint::{save_epoch, CheckpointHeader, TrainingState};
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
-use mocap_nn::train::{optimizer_step, run_epochs, EpochPlan, History};
+use mocap_nn::train::{epoch_seed, optimizer_step, run_epochs, EpochPlan, History};
 use rand::rngs::ChaCha8Rng;
 use rand::{Rng, RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -34,135 +29,21 @@ use crate::dataset::{
     list_bvh, load_takes, looped_window, paths_in_split, window, DataDescription, Split,
     SplitFractions, Take,
 };
-use crate::features::{FeatureLayout, Recentering, Representation, RotationFrame};
-use crate::filters::{filter_features, Filter};
+use crate::features::{FeatureLayout, Representation, RotationFrame};
+use crate::filters::Filter;
 use crate::fk::FkSkeleton;
-use crate::loss::{binary_cross_entropy_with_logits, derivative_loss, position_loss, LossWeights};
-use crate::model::{Denoiser, DenoiserConfig, Head};
-use crate::noise::{add_noise_with_spikes, NoiseConfig, Spike};
-use crate::spikes::spike_mask;
-use crate::wiener::{WienerDescription, WienerFilter, WienerOutcome};
+use crate::loss::{derivative_loss, position_loss, LossWeights};
+use crate::model::{Denoiser, DenoiserConfig};
+use crate::model_file::{
+    base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
+    CHECKPOINT_KIND_VERSION,
+};
+use crate::noise::{add_noise, NoiseConfig};
+use crate::wiener::WienerFilter;
 use crate::{CleanError, Result};
-
-/// The kind written in checkpoint headers.
-pub const CHECKPOINT_KIND: &str = "mocap-clean/denoiser";
-/// Version of [`ModelDescription`]'s layout.
-pub const CHECKPOINT_KIND_VERSION: u32 = 1;
 
 /// The seed of the validation windows (fixed across runs).
 const VALIDATION_SEED: u64 = 0x0005_eed0_fba1;
-
-/// Everything needed to rebuild a trained denoiser, stored in its checkpoint.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ModelDescription {
-    pub network: DenoiserConfig,
-    pub representation: Representation,
-    /// Local rotations or rotations relative to the pelvis (models written
-    /// before this field existed are local).
-    #[serde(default)]
-    pub frame: RotationFrame,
-    /// Names of the joints whose rotations are features, in order.
-    pub joints: Vec<String>,
-    /// Frame rate of the training data (the loss differences use it).
-    pub fps: f32,
-    /// A classical filter the network's correction is added to: the model's
-    /// output is `base(x) + (N(x) - x)` instead of `N(x)` (`N` has a global
-    /// skip, so `N(x) - x` is its correction). At the start of training the
-    /// correction is near zero and the model is as good as the filter;
-    /// training learns what the filter gets wrong. `None`: the report's
-    /// model.
-    #[serde(default)]
-    pub base_filter: Option<Filter>,
-    /// How much of the take the base filter sees. `0` (models written before
-    /// this field): each window alone, in training and in use alike. `N > 0`:
-    /// in use the filter runs once over the whole take; in training over the
-    /// window and up to `N` frames of its take on each side, so that a filter
-    /// that adapts to what it sees (`butterworth-gcv`, whose cutoff chosen on
-    /// a 32-frame window is poor) is trained with nearly what it sees in use.
-    #[serde(default)]
-    pub base_context: usize,
-    /// A learned Wiener filter ([`crate::wiener`]) the network corrects
-    /// instead of a classical one (same rule as `base_filter`, which is then
-    /// `None`); its numbers are stored in the model's file with the
-    /// network's weights.
-    #[serde(default)]
-    pub base_wiener: Option<WienerDescription>,
-}
-
-impl ModelDescription {
-    /// Whether the network also reads its Wiener filter's output and noise
-    /// level ([`TrainOptions::base_input`]): it has inputs beyond the
-    /// features.
-    pub fn base_input(&self) -> bool {
-        self.network.extra_inputs > 0
-    }
-}
-
-/// The inputs a network reading its base adds to `features` channels: the
-/// base's output, then the noise level ([`TrainOptions::base_input`]).
-pub(crate) fn base_input_channels(features: usize) -> usize {
-    features + 1
-}
-
-/// The unit of the noise-level input of a model with
-/// [`TrainOptions::base_input`]: the report's largest noise, so that the
-/// input is about 0 to 1.
-pub const NOISE_LEVEL_UNIT_DEG: f64 = 10.0;
-
-/// What a model's network corrects, ready to run: a classical filter at a
-/// frame rate ([`ModelDescription::base_filter`]) or a learned Wiener filter
-/// ([`ModelDescription::base_wiener`]).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Base<'a> {
-    Classical(Filter, f32),
-    Wiener(&'a WienerFilter),
-}
-
-impl<'a> Base<'a> {
-    /// The base of a model with `filter` at `fps` or `wiener` (at most one
-    /// of them: training and loading refuse both), if any.
-    pub(crate) fn of(
-        filter: Option<Filter>,
-        fps: f32,
-        wiener: Option<&'a WienerFilter>,
-    ) -> Option<Self> {
-        match (filter, wiener) {
-            (Some(filter), _) => Some(Base::Classical(filter, fps)),
-            (None, Some(wiener)) => Some(Base::Wiener(wiener)),
-            (None, None) => None,
-        }
-    }
-
-    /// Filters `features` (frames x `channels`) in place; a Wiener filter
-    /// also says the noise level it used (degrees): `level_deg` when given,
-    /// else the one it estimated.
-    pub(crate) fn apply(
-        &self,
-        features: &mut [f32],
-        channels: usize,
-        level_deg: Option<f64>,
-    ) -> Option<f64> {
-        self.apply_reporting(features, channels, level_deg)
-            .map(|outcome| outcome.sigma_deg)
-    }
-
-    /// [`Base::apply`], with all a Wiener filter says of what it did (the
-    /// level and, in a mixture, the component).
-    pub(crate) fn apply_reporting(
-        &self,
-        features: &mut [f32],
-        channels: usize,
-        level_deg: Option<f64>,
-    ) -> Option<WienerOutcome> {
-        match self {
-            Base::Classical(filter, fps) => {
-                filter_features(features, channels, filter, *fps);
-                None
-            }
-            Base::Wiener(wiener) => Some(wiener.filter_features(features, level_deg)),
-        }
-    }
-}
 
 /// Options of `mocap clean train`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -185,22 +66,22 @@ pub struct TrainOptions {
     /// See [`ModelDescription::base_context`].
     #[serde(default)]
     pub base_context: usize,
-    /// A Wiener filter file (`mocap clean train --wiener`) the network
+    /// A Wiener filter file (`mocap clean fit-wiener`) the network
     /// corrects, instead of `base_filter` (see
     /// [`ModelDescription::base_wiener`]).
     #[serde(default)]
     pub base_wiener: Option<PathBuf>,
     /// The network also reads its Wiener filter's output and the noise level
-    /// the filter estimated (degrees over [`NOISE_LEVEL_UNIT_DEG`], constant
+    /// the filter estimated (in units of 10 degrees, the report's largest noise; constant
     /// along the window; only a Wiener filter estimates one, so this needs
     /// `base_wiener`), after the noisy features, and its correction is
-    /// multiplied by that level (see [`crate::model`]).
+    /// multiplied by that level (see [`crate::DenoiserConfig::extra_inputs`]).
     ///
     /// Without them the network sees only the noisy window, so it cannot
     /// tell what the filter (which sees the whole take) already did, nor how
     /// noisy the take is: it then adds a correction of the average noise
     /// level to a clean take too (measured: 0.81 degrees on clean test takes
-    /// for the model shipped in session 7). A noise-level input is how
+    /// for such a model). A noise-level input is how
     /// FFDNet (Zhang, Zuo and Zhang 2018) makes one denoiser serve every
     /// noise level. The inputs alone did not stop that (0.85 degrees on 40
     /// clean test takes after 4 epochs), hence the scaling: where the filter
@@ -234,10 +115,6 @@ pub struct TrainOptions {
     /// squared skeleton unit; 0 leaves it out (the report's loss).
     #[serde(default)]
     pub position_weight: f32,
-    /// Train the spike detector of [`crate::spikes`] instead of a denoiser
-    /// (see the module docs).
-    #[serde(default)]
-    pub spike_detector: bool,
 }
 
 impl Default for TrainOptions {
@@ -271,7 +148,6 @@ impl Default for TrainOptions {
             plot: None,
             max_train_takes: None,
             position_weight: 0.0,
-            spike_detector: false,
         }
     }
 }
@@ -311,9 +187,6 @@ pub struct WindowSampler<'a> {
     /// Frames of the take the noise and the base filter see on each side of
     /// the window ([`ModelDescription::base_context`]).
     context: usize,
-    /// Targets are spike masks (one value per joint and frame) instead of
-    /// the clean features.
-    spike_targets: bool,
     /// The input also holds the base's output and noise level
     /// ([`TrainOptions::base_input`]).
     base_input: bool,
@@ -351,7 +224,6 @@ impl<'a> WindowSampler<'a> {
             noise,
             base: None,
             context: 0,
-            spike_targets: false,
             base_input: false,
         })
     }
@@ -365,11 +237,6 @@ impl<'a> WindowSampler<'a> {
         self.base = base;
         self.context = if self.base.is_some() { context } else { 0 };
         self
-    }
-
-    /// The sampler with a classical filter at `fps` as its base (see `with_base`).
-    pub fn with_base_filter(self, base: Option<Filter>, fps: f32, context: usize) -> Self {
-        self.with_base(base.map(|f| Base::Classical(f, fps)), context)
     }
 
     /// Inputs that also hold the base's output and the noise level it
@@ -391,50 +258,12 @@ impl<'a> WindowSampler<'a> {
         }
     }
 
-    /// Targets for a spike detector: the mask of the added spikes
-    /// ([`spike_mask`]), `[batch, joints, frames]`.
-    pub fn with_spike_targets(mut self, on: bool) -> Self {
-        self.spike_targets = on;
-        self
-    }
-
-    /// Rows of a target window: features, or joints for spike masks.
-    fn target_channels(&self) -> usize {
-        if self.spike_targets {
-            self.layout.joints.len()
-        } else {
-            self.layout.channels()
-        }
-    }
-
     fn pick<R: Rng + ?Sized>(&self, rng: &mut R) -> (usize, usize) {
         let total = *self.cumulative.last().expect("at least two takes");
         let u = rng.random_range(0..total);
         let t = self.cumulative.partition_point(|&c| c <= u);
         let before = if t == 0 { 0 } else { self.cumulative[t - 1] };
         (t, u - before)
-    }
-
-    /// One clean window and its noisy copy.
-    pub fn sample_motion<R: Rng + ?Sized>(&self, rng: &mut R) -> Result<(Motion, Motion)> {
-        let (noisy, clean, _) = self.sample_with_spikes(rng)?;
-        Ok((noisy, clean))
-    }
-
-    /// One clean window, its noisy copy and the spikes added to it (frames
-    /// counted from the window's start; with a context, the spikes that
-    /// touch the window, cut to it).
-    pub fn sample_with_spikes<R: Rng + ?Sized>(
-        &self,
-        rng: &mut R,
-    ) -> Result<(Motion, Motion, Vec<Spike>)> {
-        let stretch = self.sample_stretch(rng)?;
-        let (at, t) = (stretch.window_start, self.frames);
-        Ok((
-            window(&stretch.noisy, at, t),
-            window(&stretch.clean, at, t),
-            spikes_in_window(&stretch.spikes, at, t),
-        ))
     }
 
     /// A window with up to `context` frames of its take on each side (as
@@ -455,17 +284,15 @@ impl<'a> WindowSampler<'a> {
             donors.push(looped_window(&self.takes[d].motion, s, end - first));
         }
         let donor_refs: Vec<&Motion> = donors.iter().collect();
-        let (noisy, spikes) = add_noise_with_spikes(&clean, &donor_refs, &self.noise, rng)?;
+        let noisy = add_noise(&clean, &donor_refs, &self.noise, rng)?;
         Ok(Stretch {
             noisy,
             clean,
-            spikes,
             window_start: start - first,
         })
     }
 
-    /// A batch as `[batch, channels, frames]` tensor data (noisy, clean), or
-    /// (noisy, spike mask `[batch, joints, frames]`) with spike targets.
+    /// A batch as `[batch, channels, frames]` tensor data (noisy, clean).
     ///
     /// Each sample has its own generator seeded from `rng`, so the batch is
     /// the same whatever the number of threads that make it.
@@ -473,20 +300,12 @@ impl<'a> WindowSampler<'a> {
         use rayon::prelude::*;
         let c = self.layout.channels();
         let ci = self.input_channels();
-        let cy = self.target_channels();
         let t = self.frames;
         let seeds: Vec<u64> = (0..size).map(|_| rng.random::<u64>()).collect();
         let samples = seeds
             .par_iter()
             .map(|&seed| {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
-                if self.spike_targets {
-                    let (noisy, clean, spikes) = self.sample_with_spikes(&mut rng)?;
-                    let mut xf = self.layout.encode(&noisy);
-                    self.layout.recenter(&mut xf);
-                    let mask = spike_mask(&clean, &noisy, &self.layout.joints, &spikes);
-                    return Ok((xf, mask));
-                }
                 let stretch = self.sample_stretch(&mut rng)?;
                 let xs = self.layout.encode(&stretch.noisy);
                 let mut ys = self.layout.encode(&stretch.clean);
@@ -524,14 +343,14 @@ impl<'a> WindowSampler<'a> {
             })
             .collect::<Result<Vec<_>>>()?;
         let mut x = vec![0.0; size * ci * t];
-        let mut y = vec![0.0; size * cy * t];
+        let mut y = vec![0.0; size * c * t];
         for (b, (xf, yf)) in samples.iter().enumerate() {
             for f in 0..t {
                 for ch in 0..ci {
                     x[(b * ci + ch) * t + f] = xf[f * ci + ch];
                 }
-                for ch in 0..cy {
-                    y[(b * cy + ch) * t + f] = yf[f * cy + ch];
+                for ch in 0..c {
+                    y[(b * c + ch) * t + f] = yf[f * c + ch];
                 }
             }
         }
@@ -539,80 +358,11 @@ impl<'a> WindowSampler<'a> {
     }
 }
 
-/// The base filter's output for the recentred window `window` of
-/// `channels` features, in training and in use alike (see
-/// [`ModelDescription::base_context`]): `filtered_around` is the same frames
-/// cut from the filter's output over a longer stretch (the take around the
-/// window), brought here onto the window's branch; without it the filter
-/// runs on the window itself, at noise level `level_deg` when given (else
-/// the one it estimates there).
-pub(crate) fn window_base(
-    window: &[f32],
-    filtered_around: Option<&[f32]>,
-    recentering: &Recentering,
-    base: &Base,
-    channels: usize,
-    level_deg: Option<f64>,
-) -> (Vec<f32>, Option<f64>) {
-    match filtered_around {
-        Some(around) => {
-            let mut base = around.to_vec();
-            recentering.apply(&mut base);
-            (base, None)
-        }
-        None => {
-            let mut filtered = window.to_vec();
-            let level = base.apply(&mut filtered, channels, level_deg);
-            (filtered, level)
-        }
-    }
-}
-
-/// The input of a model with [`TrainOptions::base_input`]: every frame's
-/// `channels` noisy features, then the base's output at that frame, then the
-/// noise level the Wiener filter estimated (degrees; `None` counts as 0) over
-/// [`NOISE_LEVEL_UNIT_DEG`]. Frames by rows, as `window` and `base` are.
-pub(crate) fn with_base_input(
-    window: &[f32],
-    base: &[f32],
-    level_deg: Option<f64>,
-    channels: usize,
-) -> Vec<f32> {
-    let level = (level_deg.unwrap_or(0.0) / NOISE_LEVEL_UNIT_DEG) as f32;
-    let mut input = Vec::with_capacity(window.len() * 2 + window.len() / channels.max(1));
-    for (x, b) in window.chunks(channels).zip(base.chunks(channels)) {
-        input.extend_from_slice(x);
-        input.extend_from_slice(b);
-        input.push(level);
-    }
-    input
-}
-
-/// The parts of `spikes` within frames `start..start + frames`, counted from
-/// `start`.
-fn spikes_in_window(spikes: &[Spike], start: usize, frames: usize) -> Vec<Spike> {
-    let end = start + frames;
-    spikes
-        .iter()
-        .filter(|s| s.start < end && s.start + s.frames > start)
-        .map(|s| {
-            let first = s.start.max(start);
-            Spike {
-                start: first - start,
-                frames: (s.start + s.frames).min(end) - first,
-                ..*s
-            }
-        })
-        .collect()
-}
-
 /// A window of a take with its context, clean and noisy (see
 /// [`WindowSampler::sample_stretch`]).
 struct Stretch {
     noisy: Motion,
     clean: Motion,
-    /// The spikes added, frames counted from the stretch's start.
-    spikes: Vec<Spike>,
     /// Where the window starts in the stretch.
     window_start: usize,
 }
@@ -621,15 +371,12 @@ fn tensor(data: Vec<f32>, shape: [usize; 3], device: &Device) -> Tensor<3> {
     Tensor::from_data(TensorData::new(data, shape), device)
 }
 
-/// The mean squared error of `model` on fixed validation batches, or the
-/// binary cross-entropy for a spike detector (`target_shape` has one row per
-/// joint).
+/// The mean squared error of `model` on fixed validation batches.
 fn validation_loss(
     model: &Denoiser,
     batches: &[(Vec<f32>, Vec<f32>)],
     shape: [usize; 3],
     target_shape: [usize; 3],
-    spike_detector: bool,
     device: &Device,
 ) -> f64 {
     let model = model.valid();
@@ -637,11 +384,7 @@ fn validation_loss(
     for (x, y) in batches {
         let pred = model.forward(tensor(x.clone(), shape, device));
         let target = tensor(y.clone(), target_shape, device);
-        let loss: f32 = if spike_detector {
-            binary_cross_entropy_with_logits(pred, target).into_scalar()
-        } else {
-            (pred - target).powi_scalar(2).mean().into_scalar()
-        };
+        let loss: f32 = (pred - target).powi_scalar(2).mean().into_scalar();
         sum += loss as f64;
     }
     sum / batches.len().max(1) as f64
@@ -673,16 +416,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     network.channels = layout.channels();
     // Any base: a classical filter or a Wiener filter.
     let any_base = options.base_filter.is_some() || options.base_wiener.is_some();
-    if options.spike_detector {
-        if any_base || options.position_weight > 0.0 {
-            return Err(CleanError::Invalid(
-                "a spike detector has no base filter and no position term".into(),
-            ));
-        }
-        network.head = Head::SpikeLogits {
-            joints: layout.joints.len(),
-        };
-    }
     network.validate()?;
     // A learned Wiener filter as the base: fitted to this rig's 6D local
     // rotations, which the network must then read too.
@@ -778,12 +511,10 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     };
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
         .with_base(base, options.base_context)
-        .with_base_input(options.base_input)
-        .with_spike_targets(options.spike_detector);
+        .with_base_input(options.base_input);
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
         .with_base(base, options.base_context)
-        .with_base_input(options.base_input)
-        .with_spike_targets(options.spike_detector);
+        .with_base_input(options.base_input);
     let shape = [options.batch_size, network.input_channels(), network.window];
     let target_shape = [
         options.batch_size,
@@ -799,16 +530,8 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         .collect::<Result<Vec<_>>>()?;
 
     // The validation MSE of doing nothing (the noisy input itself), for
-    // scale; for a spike detector, the cross-entropy of always answering the
-    // share of spiked joints and frames.
-    let validation_input_mse = if options.spike_detector {
-        let (ones, total) = valid_batches.iter().fold((0.0, 0usize), |(o, n), (_, y)| {
-            (o + y.iter().map(|&v| v as f64).sum::<f64>(), n + y.len())
-        });
-        let p = (ones / total.max(1) as f64).clamp(1e-9, 1.0 - 1e-9);
-        -(p * p.ln() + (1.0 - p) * (1.0 - p).ln())
-    } else {
-        // The features are the first rows of every sample's input.
+    // scale. The features are the first rows of every sample's input.
+    let validation_input_mse = {
         let (ci, c, t) = (network.input_channels(), network.channels, network.window);
         valid_batches
             .iter()
@@ -883,9 +606,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         plan,
         |run, epoch, _step| -> Result<f64> {
             if run.rng_epoch != epoch {
-                run.rng = ChaCha8Rng::seed_from_u64(
-                    options.seed ^ (epoch as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15),
-                );
+                run.rng = ChaCha8Rng::seed_from_u64(epoch_seed(options.seed, epoch));
                 run.rng_epoch = epoch;
             }
             let data_start = Instant::now();
@@ -894,11 +615,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
             let model = run.model.take().expect("model present");
             let pred = model.forward(tensor(x, shape, &device));
             let target = tensor(y, target_shape, &device);
-            let mut l = if options.spike_detector {
-                binary_cross_entropy_with_logits(pred.clone(), target.clone())
-            } else {
-                derivative_loss(pred.clone(), target.clone(), &loss)
-            };
+            let mut l = derivative_loss(pred.clone(), target.clone(), &loss);
             if let Some(fk) = &fk {
                 l = l + position_loss(fk, pred, target) * options.position_weight;
             }
@@ -913,7 +630,6 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 &valid_batches,
                 shape,
                 target_shape,
-                options.spike_detector,
                 &plain_device,
             ))
         },
@@ -932,23 +648,16 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
                 &written,
                 &header(history),
                 &plot,
-                &if options.spike_detector {
-                    PlotOptions {
-                        y_label: "binary cross-entropy".into(),
-                        ..PlotOptions::new("mocap-clean spike detector training")
-                    }
-                } else {
-                    PlotOptions {
-                        y_label: "loss (training: chosen loss; validation: MSE)".into(),
-                        ..PlotOptions::new(format!(
-                            "mocap-clean training ({})",
-                            if loss.is_mse() {
-                                "MSE"
-                            } else {
-                                "derivative loss"
-                            }
-                        ))
-                    }
+                &PlotOptions {
+                    y_label: "loss (training: chosen loss; validation: MSE)".into(),
+                    ..PlotOptions::new(format!(
+                        "mocap-clean training ({})",
+                        if loss.is_mse() {
+                            "MSE"
+                        } else {
+                            "derivative loss"
+                        }
+                    ))
                 },
             )?;
             Ok(())
@@ -976,8 +685,17 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
 }
 
 #[cfg(test)]
+impl<'a> WindowSampler<'a> {
+    /// The sampler with a classical filter at `fps` as its base (see `with_base`).
+    fn with_base_filter(self, base: Option<Filter>, fps: f32, context: usize) -> Self {
+        self.with_base(base.map(|f| Base::Classical(f, fps)), context)
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
+    use crate::filters::filter_features;
     use crate::test_support::synthetic_motion_phase;
     use mocap_core::io::bvh::write_bvh;
 
@@ -1002,7 +720,6 @@ mod tests {
                 blocks: 1,
                 kernel: 3,
                 window: 8,
-                head: Head::Correction,
                 extra_inputs: 0,
             },
             epochs: 2,
@@ -1108,26 +825,6 @@ mod tests {
         assert!(moved > 1e-3);
     }
 
-    #[test]
-    fn spikes_are_cut_to_the_window() {
-        let spike = |joint, start, frames| Spike {
-            joint,
-            start,
-            frames,
-        };
-        let spikes = [
-            spike(1, 0, 5),   // ends before the window
-            spike(2, 8, 4),   // starts before it
-            spike(3, 12, 3),  // inside
-            spike(4, 18, 10), // ends after it
-            spike(5, 20, 2),  // starts after it
-        ];
-        assert_eq!(
-            spikes_in_window(&spikes, 10, 10),
-            vec![spike(2, 0, 2), spike(3, 2, 3), spike(4, 8, 2)]
-        );
-    }
-
     /// With a context the base filter runs on the window's take around it,
     /// as in use on the whole take; without one on the window alone.
     #[test]
@@ -1196,7 +893,7 @@ mod tests {
             ..tiny_setup(dir.path())
         };
         let report = train(&options).unwrap();
-        let model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let model = crate::model_file::CleanModel::load(&report.model, Default::default()).unwrap();
         assert_eq!(model.description.base_filter, options.base_filter);
         let motion = synthetic_motion_phase(50, 4, 0.5);
         let cleaned = model.clean(&motion, None).unwrap();
@@ -1215,7 +912,8 @@ mod tests {
             ..tiny_setup(dir.path())
         };
         let report = train(&options).unwrap();
-        let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let mut model =
+            crate::model_file::CleanModel::load(&report.model, Default::default()).unwrap();
         assert_eq!(model.description.base_context, 16);
         let mut motion = synthetic_motion_phase(50, 4, 0.5);
         let noise = NoiseConfig {
@@ -1253,7 +951,7 @@ mod tests {
     fn tiny_setup_on_wiener(dir: &Path, out: &str) -> (TrainOptions, PathBuf) {
         let setup = tiny_setup(dir);
         let wiener_path = dir.join("wiener.safetensors");
-        crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+        crate::wiener_fit::fit_wiener(&crate::wiener_fit::WienerFitOptions {
             inputs: setup.inputs.clone(),
             out: wiener_path.clone(),
             split: setup.split,
@@ -1289,7 +987,8 @@ mod tests {
         // The model's file alone is enough: the filter rides in it.
         let kept = dir.path().join("kept.safetensors");
         std::fs::rename(&wiener_path, &kept).unwrap();
-        let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let mut model =
+            crate::model_file::CleanModel::load(&report.model, Default::default()).unwrap();
         let stored = model.description.base_wiener.clone().unwrap();
         assert_eq!(stored.joints.len(), 4);
         let noisy = noisy_four_joint_take();
@@ -1307,24 +1006,24 @@ mod tests {
         );
         assert!(wiener.is_err(), "a model file is not a Wiener filter file");
         let (filtered, _) = model_base(&model).clean(&noisy, None).unwrap();
-        let off = crate::eval::rotation_error_deg(&filtered, &zeroed);
+        let off = crate::metrics::rotation_error_deg(&filtered, &zeroed);
         assert!(off < 1e-3, "{off} degrees from the Wiener filter");
-        assert!(crate::eval::rotation_error_deg(&filtered, &noisy) > 0.1);
+        assert!(crate::metrics::rotation_error_deg(&filtered, &noisy) > 0.1);
         // A noise level given instead of estimated reaches the filter.
         let (at_level, level) = model.clean_at_level(&noisy, None, Some(1.0)).unwrap();
         assert_eq!(level, Some(1.0));
         let (filtered_at_level, _) = model_base(&model).clean(&noisy, Some(1.0)).unwrap();
-        let off = crate::eval::rotation_error_deg(&filtered_at_level, &at_level);
+        let off = crate::metrics::rotation_error_deg(&filtered_at_level, &at_level);
         assert!(
             off < 1e-3,
             "{off} degrees from the Wiener filter at 1 degree"
         );
-        assert!(crate::eval::rotation_error_deg(&filtered_at_level, &filtered) > 0.01);
+        assert!(crate::metrics::rotation_error_deg(&filtered_at_level, &filtered) > 0.01);
         // So it does when the filter runs on each window alone.
         model.description.base_context = 0;
         let per_window = |level: f64| model.clean_at_level(&noisy, None, Some(level)).unwrap();
         let ((low, _), (high, _)) = (per_window(1.0), per_window(8.0));
-        assert!(crate::eval::rotation_error_deg(&low, &high) > 0.01);
+        assert!(crate::metrics::rotation_error_deg(&low, &high) > 0.01);
         // Not both bases, and not on features a Wiener filter cannot read.
         std::fs::rename(&kept, &wiener_path).unwrap();
         for (wrong, why) in [
@@ -1355,7 +1054,7 @@ mod tests {
         let (options, wiener_path) = tiny_setup_on_wiener(dir.path(), "to-rebase.safetensors");
         let report = train(&options).unwrap();
         let rebased_path = dir.path().join("rebased.safetensors");
-        let fit = crate::wiener::WienerFitOptions {
+        let fit = crate::wiener_fit::WienerFitOptions {
             inputs: options.inputs.clone(),
             out: rebased_path.clone(),
             split: options.split,
@@ -1363,7 +1062,7 @@ mod tests {
             rebase: Some(report.model.clone()),
             ..Default::default()
         };
-        let fitted = crate::wiener::fit_files(&fit).unwrap();
+        let fitted = crate::wiener_fit::fit_wiener(&fit).unwrap();
         // The synthetic take names carry no content: the rest and all.
         let names: Vec<&str> = fitted
             .description
@@ -1372,20 +1071,22 @@ mod tests {
             .map(|c| c.name.as_str())
             .collect();
         assert_eq!(names, ["other", "all"]);
-        let original = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
-        let rebased = crate::infer::CleanModel::load(&rebased_path, Default::default()).unwrap();
+        let original =
+            crate::model_file::CleanModel::load(&report.model, Default::default()).unwrap();
+        let rebased =
+            crate::model_file::CleanModel::load(&rebased_path, Default::default()).unwrap();
         assert_eq!(rebased.description.network, original.description.network);
         assert_eq!(model_base(&rebased).description.component_count(), 2);
         // The same network on a filter whose components both come from the
         // same takes: nearly the same output.
         let noisy = noisy_four_joint_take();
-        let off = crate::eval::rotation_error_deg(
+        let off = crate::metrics::rotation_error_deg(
             &original.clean(&noisy, None).unwrap(),
             &rebased.clean(&noisy, None).unwrap(),
         );
         assert!(off < 0.5, "{off} degrees apart");
         // The header keeps the network's training record and says what was done.
-        let (data, training) = crate::infer::CleanModel::header_of(&rebased_path).unwrap();
+        let (data, training) = crate::model_file::CleanModel::header_of(&rebased_path).unwrap();
         assert!(data["rebased"]["mixture_min_segments"] == 1, "{data}");
         assert!(!training.is_null());
         // A filter with another noise covariance is refused, and so is a
@@ -1395,14 +1096,14 @@ mod tests {
         let other =
             WienerFilter::fit(&refs, &crate::noise::RandomNoise::default(), 3.0, 32, 9).unwrap();
         assert!(original.with_base_wiener(other).is_err());
-        let error = crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+        let error = crate::wiener_fit::fit_wiener(&crate::wiener_fit::WienerFitOptions {
             mixture_min_segments: None,
             ..fit.clone()
         })
         .unwrap_err()
         .to_string();
         assert!(error.contains("needs a mixture"), "{error}");
-        let error = crate::wiener::fit_files(&crate::wiener::WienerFitOptions {
+        let error = crate::wiener_fit::fit_wiener(&crate::wiener_fit::WienerFitOptions {
             rebase: Some(wiener_path),
             ..fit
         })
@@ -1421,7 +1122,8 @@ mod tests {
             ..on_wiener
         };
         let report = train(&options).unwrap();
-        let mut model = crate::infer::CleanModel::load(&report.model, Default::default()).unwrap();
+        let mut model =
+            crate::model_file::CleanModel::load(&report.model, Default::default()).unwrap();
         let c = model.description.network.channels;
         assert!(model.description.base_input());
         assert_eq!(model.description.network.input_channels(), 2 * c + 1);
@@ -1465,7 +1167,7 @@ mod tests {
         model.zero_output();
         let zeroed = model.clean(&noisy, None).unwrap();
         let (filtered, _) = model_base(&model).clean(&noisy, None).unwrap();
-        let off = crate::eval::rotation_error_deg(&filtered, &zeroed);
+        let off = crate::metrics::rotation_error_deg(&filtered, &zeroed);
         assert!(off < 1e-3, "{off} degrees from the Wiener filter");
 
         // It needs a base to read.
@@ -1480,54 +1182,7 @@ mod tests {
     }
 
     /// The Wiener filter a loaded model corrects.
-    fn model_base(model: &crate::infer::CleanModel) -> &crate::wiener::WienerFilter {
+    fn model_base(model: &crate::model_file::CleanModel) -> &crate::wiener::WienerFilter {
         model.base_wiener().expect("a model on a Wiener filter")
-    }
-
-    #[test]
-    fn a_spike_detector_trains_and_is_told_apart_from_a_denoiser() {
-        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-        let dir = tempfile::tempdir().unwrap();
-        let options = TrainOptions {
-            out: dir.path().join("spikes.safetensors"),
-            spike_detector: true,
-            ..tiny_setup(dir.path())
-        };
-        let report = train(&options).unwrap();
-        // The validation targets hold spikes: with an empty mask the base
-        // rate's cross-entropy would be ~0 (the share is clamped at 1e-9).
-        assert!(
-            report.validation_input_mse > 0.01,
-            "{}",
-            report.validation_input_mse
-        );
-        assert!(report
-            .history
-            .epochs
-            .iter()
-            .all(|e| e.valid_loss.is_finite() && e.valid_loss > 0.0));
-        let motion = synthetic_motion_phase(50, 4, 0.5);
-        let detector =
-            crate::spikes::SpikeDetector::load(&report.model, Default::default()).unwrap();
-        let p = detector.probabilities(&motion).unwrap();
-        assert_eq!(p.len(), 50 * report.description.joints.len());
-        assert!(p.iter().all(|v| (0.0..=1.0).contains(v)));
-        // Used as a denoiser, it is a clear error; a denoiser used as a
-        // detector too.
-        let as_denoiser = crate::infer::CleanModel::load(&report.model, Default::default())
-            .unwrap()
-            .clean(&motion, None)
-            .unwrap_err()
-            .to_string();
-        assert!(as_denoiser.contains("spike detector"), "{as_denoiser}");
-        let denoiser = train(&TrainOptions {
-            out: dir.path().join("denoiser.safetensors"),
-            ..tiny_setup(dir.path())
-        })
-        .unwrap();
-        let e = crate::spikes::SpikeDetector::load(&denoiser.model, Default::default())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("not a spike detector"), "{e}");
     }
 }

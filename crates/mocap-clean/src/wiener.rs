@@ -86,9 +86,8 @@
 //! by name and order) and one frame rate, like a network.
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::{Arc, OnceLock};
-use std::time::Instant;
 
 use burn::module::{Module, Param};
 use burn::tensor::{Device, Tensor, TensorData};
@@ -103,9 +102,7 @@ use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::{
-    list_bvh, load_takes, paths_in_split, DataDescription, Split, SplitFractions, Take,
-};
+use crate::dataset::Take;
 use crate::features::{FeatureLayout, Representation};
 use crate::noise::{add_random_noise_sigma, RandomNoise};
 use crate::{CleanError, Result};
@@ -374,7 +371,7 @@ pub struct WienerFilter {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LevelEstimate {
     /// The level of largest likelihood (2) of each segment on its own, and
-    /// the median of those levels (the default since session 23). A few
+    /// the median of those levels (the default). A few
     /// segments that hold something the noise model does not know (a spike
     /// the finder missed, the remains of a bridged one, a burst of motion
     /// faster than the training spectra) then do not raise the level of
@@ -383,8 +380,8 @@ pub enum LevelEstimate {
     /// `bench/results/clean.md`.
     #[default]
     SegmentMedian,
-    /// The level of largest likelihood (2) over all segments together
-    /// (sessions 7-22): the most precise estimate when every segment is
+    /// The level of largest likelihood (2) over all segments together: the
+    /// most precise estimate when every segment is
     /// noisy alike, but one spiked segment raises it for the whole take.
     Pooled,
 }
@@ -884,7 +881,7 @@ impl WienerFilter {
             return Err(CleanError::Invalid(format!(
                 "the Wiener filter was fitted to a rig of {} joints with rotations ({}, ...), \
                  this take has {} ({}, ...): clean it with --filter, or fit one to this rig \
-                 with `mocap clean train --wiener`",
+                 with `mocap clean fit-wiener`",
                 d.len(),
                 d[..d.len().min(3)].join(", "),
                 names.len(),
@@ -1382,157 +1379,6 @@ impl WienerFilter {
     }
 }
 
-/// Options of `mocap clean train --wiener`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct WienerFitOptions {
-    /// Folders or files of clean BVH takes; the training split is used.
-    pub inputs: Vec<PathBuf>,
-    pub out: PathBuf,
-    pub split: SplitFractions,
-    /// Frames per Fourier segment (32 measured best of 16-128 on Bandai,
-    /// bench/results/clean.md).
-    pub segment: usize,
-    pub noise: RandomNoise,
-    /// The level `N` is measured at (the noise is nearly linear in it).
-    pub noise_sigma_deg: f32,
-    pub seed: u64,
-    /// Fit to at most this many training takes (quick runs and tests).
-    pub max_train_takes: Option<usize>,
-    /// Fit a mixture ([`fit_mixture`]): one component per content with at
-    /// least this many training segments. `None`: one set of spectra.
-    #[serde(default)]
-    pub mixture_min_segments: Option<usize>,
-    /// With a mixture: build it from the Wiener filter that this network
-    /// model corrects (keeping its noise covariance, so the level the
-    /// network reads means the same) and write that network, not
-    /// retrained, with the mixture under it.
-    #[serde(default)]
-    pub rebase: Option<PathBuf>,
-}
-
-impl Default for WienerFitOptions {
-    fn default() -> Self {
-        WienerFitOptions {
-            inputs: Vec::new(),
-            out: PathBuf::from("clean-wiener.safetensors"),
-            split: SplitFractions::default(),
-            segment: 32,
-            noise: RandomNoise::default(),
-            noise_sigma_deg: 5.0,
-            seed: 1,
-            max_train_takes: None,
-            mixture_min_segments: None,
-            rebase: None,
-        }
-    }
-}
-
-/// What fitting wrote.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct WienerFitReport {
-    pub model: PathBuf,
-    pub description: WienerDescription,
-    pub data: DataDescription,
-    pub seconds: f64,
-}
-
-/// Fits a filter to the training takes of `options.inputs` and writes it.
-pub fn fit_files(options: &WienerFitOptions) -> Result<WienerFitReport> {
-    let started = Instant::now();
-    let paths = list_bvh(&options.inputs)?;
-    let mut train_paths = paths_in_split(&paths, Split::Train, &options.split);
-    if let Some(max) = options.max_train_takes {
-        train_paths.truncate(max);
-    }
-    let takes = load_takes(&train_paths)?;
-    if let Some(model_path) = &options.rebase {
-        return rebase(options, model_path, &takes, &paths, started);
-    }
-    let motions: Vec<&Motion> = takes.iter().map(|t| &t.motion).collect();
-    let mut filter = WienerFilter::fit(
-        &motions,
-        &options.noise,
-        options.noise_sigma_deg,
-        options.segment,
-        options.seed,
-    )?;
-    if let Some(min_segments) = options.mixture_min_segments {
-        filter = fit_mixture(&filter, &takes, min_segments)?;
-    }
-    let data = DataDescription {
-        train_takes: filter.description.takes,
-        train_frames: filter.description.frames,
-        validation_takes: paths_in_split(&paths, Split::Validation, &options.split).len(),
-        ..DataDescription::new(
-            &options.inputs,
-            &paths,
-            options.split,
-            filter.description.fps as f64,
-        )
-    };
-    let data_json = serde_json::to_value(&data)
-        .map_err(|e| CleanError::Invalid(format!("describing the data: {e}")))?;
-    filter.save(&options.out, data_json)?;
-    Ok(WienerFitReport {
-        model: options.out.clone(),
-        description: filter.description,
-        data,
-        seconds: started.elapsed().as_secs_f64(),
-    })
-}
-
-/// [`fit_files`] with [`WienerFitOptions::rebase`].
-fn rebase(
-    options: &WienerFitOptions,
-    model_path: &Path,
-    takes: &[Take],
-    paths: &[PathBuf],
-    started: Instant,
-) -> Result<WienerFitReport> {
-    let min_segments = options.mixture_min_segments.ok_or_else(|| {
-        CleanError::Invalid("rebasing a network needs a mixture to put under it".into())
-    })?;
-    let model = crate::infer::CleanModel::load(model_path, Default::default())?;
-    let base = model.base_wiener().cloned().ok_or_else(|| {
-        CleanError::Invalid(format!(
-            "{}: this model corrects no Wiener filter",
-            model_path.display()
-        ))
-    })?;
-    let mixture = fit_mixture(&base, takes, min_segments)?;
-    let description = mixture.description.clone();
-    let model = model.with_base_wiener(mixture)?;
-    let data = DataDescription {
-        train_takes: description.takes,
-        train_frames: description.frames,
-        validation_takes: paths_in_split(paths, Split::Validation, &options.split).len(),
-        ..DataDescription::new(
-            &options.inputs,
-            paths,
-            options.split,
-            description.fps as f64,
-        )
-    };
-    let (mut header_data, training) = crate::infer::CleanModel::header_of(model_path)?;
-    if let Some(record) = header_data.as_object_mut() {
-        record.insert(
-            "rebased".into(),
-            serde_json::json!({
-                "network_from": model_path.display().to_string(),
-                "mixture_min_segments": min_segments,
-                "mixture_data": data,
-            }),
-        );
-    }
-    model.save(&options.out, header_data, training)?;
-    Ok(WienerFitReport {
-        model: options.out.clone(),
-        description,
-        data,
-        seconds: started.elapsed().as_secs_f64(),
-    })
-}
-
 /// The content of a take named `<set>_<content>_<style>_<take>` (Bandai's
 /// scheme; HDM05's `HDM_<actor>_<class>_...` gives the actor), or `None`
 /// for a name with fewer parts.
@@ -1595,7 +1441,7 @@ pub fn fit_mixture(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::rotation_error_deg;
+    use crate::metrics::rotation_error_deg;
     use crate::test_support::synthetic_motion_phase;
 
     /// Fitted to eight 8-s takes of the synthetic 5-joint chain.
@@ -1927,13 +1773,13 @@ mod tests {
         let size = |p: &Path| std::fs::metadata(p).unwrap().len() as f64;
         assert!(size(&path) < 0.6 * size(&old_path));
         // A network reader refuses it by name, and the dispatcher knows it.
-        let error = crate::infer::CleanModel::load(&path, Default::default())
+        let error = crate::model_file::CleanModel::load(&path, Default::default())
             .unwrap_err()
             .to_string();
         assert!(error.contains(WIENER_KIND), "{error}");
         assert!(matches!(
-            crate::infer::ModelFile::load(&path, Default::default()).unwrap(),
-            crate::infer::ModelFile::Wiener(_)
+            crate::model_file::ModelFile::load(&path, Default::default()).unwrap(),
+            crate::model_file::ModelFile::Wiener(_)
         ));
         let error = filter
             .clean(&synthetic_motion_phase(50, 4, 0.0), None)

@@ -3,32 +3,17 @@
 
 use std::path::PathBuf;
 
-use mocap_clean::eval::{position_errors, rotation_error_deg};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::{CleanModel, DEFAULT_MODEL_PATH};
-use mocap_clean::noise::{add_random_noise_sigma, add_spike_noise, RandomNoise, SpikeNoise};
+use mocap_clean::{
+    add_random_noise_sigma, add_spike_noise, filter_motion, position_errors, rotation_error_deg,
+    CleanModel, Filter, RandomNoise, SpikeNoise, DEFAULT_MODEL_PATH,
+};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::{forward_kinematics, Motion};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 
-fn shared_data() -> Option<PathBuf> {
-    let dir = std::env::var_os("MOCAP_SHARED_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    if dir.join("bandai").is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "note: {} not found, skipping the Bandai tests",
-            dir.display()
-        );
-        None
-    }
-}
-
 fn take(name: &str) -> Option<Motion> {
-    let dir = shared_data()?;
+    let dir = mocap_testdata::shared_data()?;
     Some(read_bvh(&dir.join("bandai/dataset-1").join(name)).expect("readable take"))
 }
 
@@ -114,18 +99,14 @@ fn filters_reduce_random_noise_on_a_real_take() {
 /// The shipped model and the dataset-1 takes of the test split (never seen
 /// in training), when the data and the model are there.
 fn shipped_model_and_test_takes() -> Option<(CleanModel, Vec<PathBuf>)> {
-    let dir = shared_data()?;
+    let dir = mocap_testdata::shared_data()?;
     if !PathBuf::from(DEFAULT_MODEL_PATH).is_file() {
         eprintln!("note: no shipped model at {DEFAULT_MODEL_PATH}");
         return None;
     }
     let model = CleanModel::load_default(Default::default()).unwrap();
-    let paths = mocap_clean::dataset::list_bvh(&[dir.join("bandai/dataset-1")]).unwrap();
-    let test = mocap_clean::dataset::paths_in_split(
-        &paths,
-        mocap_clean::dataset::Split::Test,
-        &Default::default(),
-    );
+    let paths = mocap_clean::list_bvh(&[dir.join("bandai/dataset-1")]).unwrap();
+    let test = mocap_clean::paths_in_split(&paths, mocap_clean::Split::Test, &Default::default());
     Some((model, test))
 }
 
@@ -137,8 +118,7 @@ fn the_shipped_model_cleans_a_held_out_take() {
     let motion = read_bvh(&test[0]).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let noisy = add_random_noise_sigma(&motion, 8.0, &RandomNoise::default(), &mut rng);
-    let donor =
-        mocap_clean::dataset::looped_window(&read_bvh(&test[1]).unwrap(), 0, motion.frame_count());
+    let donor = mocap_clean::looped_window(&read_bvh(&test[1]).unwrap(), 0, motion.frame_count());
     let (noisy, _) = add_spike_noise(
         &noisy,
         &[&donor],
@@ -166,8 +146,8 @@ fn the_shipped_model_cleans_a_held_out_take() {
 
 #[test]
 fn the_shipped_model_leaves_clean_held_out_takes_nearly_alone() {
-    // The model shipped in session 7 moved clean test takes by 0.81 degrees
-    // on average (its Wiener filter alone by 0.04); a model that reads the
+    // A model that does not read the noise level moved clean test takes by
+    // 0.81 degrees on average (its Wiener filter alone by 0.04); one that reads the
     // noise level its filter estimates should not. The filter does take
     // some vigorous motion for noise (an angry wave: estimated at 4.7
     // degrees, moved by 3.6; bench/results/clean.md), hence the median and
@@ -203,17 +183,17 @@ fn the_shipped_model_leaves_clean_held_out_takes_nearly_alone() {
 fn spikes_do_not_raise_the_noise_level_the_shipped_model_reads() {
     // Takes with spikes and no other noise (the evaluation's spikes-alone
     // condition, its seed), not bridged. With the level of all segments
-    // together (sessions 7-22) the spiked segments raise the level of the
+    // together (`LevelEstimate::Pooled`) the spiked segments raise the level of the
     // whole take and the model smooths all of it; the median of the
     // segments' levels (the default) keeps to the rest of the take.
-    use mocap_clean::eval::{noisy_take, EvalOptions};
-    use mocap_clean::wiener::LevelEstimate;
+    use mocap_clean::LevelEstimate;
+    use mocap_clean::{noisy_take, EvalOptions};
     let Some((median_model, test)) = shipped_model_and_test_takes() else {
         return;
     };
     let mut pooled_model = CleanModel::load_default(Default::default()).unwrap();
     pooled_model.set_level_estimate(LevelEstimate::Pooled);
-    let takes = mocap_clean::dataset::load_takes(&test).unwrap();
+    let takes = mocap_clean::load_takes(&test).unwrap();
     let spikes_alone = 2;
     let (mut error, mut level, mut frames) = ([0.0; 2], [0.0; 2], 0.0);
     for i in 0..takes.len() {
@@ -244,21 +224,17 @@ fn spikes_do_not_raise_the_noise_level_the_shipped_model_reads() {
 
 #[test]
 fn spike_finding_leaves_clean_held_out_takes_nearly_alone() {
-    // `mocap clean --despike` bridges what it takes for spikes before the
+    // `mocap clean apply --despike` bridges what it takes for spikes before the
     // model runs; on clean takes whatever it finds is a false alarm. Measured
     // on the 116 test takes: 18 get some, all but one moved by at most 0.06
     // degrees (mostly one-frame bridges of fast hands); the vigorous
     // `dataset-1_call_normal_001` by 0.8 (bench/results/clean.md).
-    use mocap_clean::despike::{remove_spikes, DespikeOptions};
-    let Some(dir) = shared_data() else {
+    use mocap_clean::{remove_spikes, DespikeOptions};
+    let Some(dir) = mocap_testdata::shared_data() else {
         return;
     };
-    let paths = mocap_clean::dataset::list_bvh(&[dir.join("bandai")]).unwrap();
-    let test = mocap_clean::dataset::paths_in_split(
-        &paths,
-        mocap_clean::dataset::Split::Test,
-        &Default::default(),
-    );
+    let paths = mocap_clean::list_bvh(&[dir.join("bandai")]).unwrap();
+    let test = mocap_clean::paths_in_split(&paths, mocap_clean::Split::Test, &Default::default());
     let mut moved: Vec<f64> = test
         .iter()
         .map(|path| {
@@ -292,8 +268,8 @@ fn spike_finding_leaves_clean_held_out_takes_nearly_alone() {
 
 #[test]
 fn a_long_spike_in_a_real_take_is_found_and_bridged() {
-    use mocap_clean::despike::{remove_spikes, DespikeOptions};
-    use mocap_clean::noise::{add_spikes, Spike};
+    use mocap_clean::{add_spikes, Spike};
+    use mocap_clean::{remove_spikes, DespikeOptions};
     let (Some(motion), Some(donor)) = (
         take("dataset-1_walk_normal_001.bvh"),
         take("dataset-1_dance-short_normal_001.bvh"),

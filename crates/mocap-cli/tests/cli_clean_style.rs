@@ -57,16 +57,15 @@ fn mean_channel_change(a: &Path, b: &Path) -> f32 {
 
 #[test]
 fn clean_with_the_shipped_model_keeps_the_layout_denoises_and_leaves_a_clean_take_alone() {
-    use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
+    use mocap_clean::{add_random_noise_sigma, RandomNoise};
     use rand::SeedableRng;
     let dir = tempfile::tempdir().unwrap();
     let input = sample("dataset-1_walk_normal_001.bvh");
     let original = read_bvh(Path::new(&input)).unwrap();
-    // The bundled walk is clean: the model leaves it alone. Measured 0.00
-    // degrees; 0.04 before session 23, when the noise level was pooled over
-    // the take's segments and its grid began at 0.05 degrees.
+    // The bundled walk is clean: the model leaves it alone (measured: 0.00
+    // degrees; with the level pooled over the take's segments, 0.04).
     let output = dir.path().join("clean.bvh");
-    let out = mocap(&["clean", &input, "-o", path(&output), "--json"]);
+    let out = mocap(&["clean", "apply", &input, "-o", path(&output), "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let cleaned = read_bvh(&output).unwrap();
@@ -85,7 +84,14 @@ fn clean_with_the_shipped_model_keeps_the_layout_denoises_and_leaves_a_clean_tak
     let noisy_path = dir.path().join("noisy.bvh");
     mocap_core::io::bvh::write_bvh(&noisy_path, &noisy).unwrap();
     let denoised = dir.path().join("denoised.bvh");
-    let out = mocap(&["clean", path(&noisy_path), "-o", path(&denoised), "--quiet"]);
+    let out = mocap(&[
+        "clean",
+        "apply",
+        path(&noisy_path),
+        "-o",
+        path(&denoised),
+        "--quiet",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let before = rotation_change_deg(Path::new(&input), &noisy_path);
     let after = rotation_change_deg(Path::new(&input), &denoised);
@@ -99,6 +105,7 @@ fn clean_with_a_filter_and_bad_inputs() {
     let output = dir.path().join("filtered.bvh");
     let out = mocap(&[
         "clean",
+        "apply",
         &input,
         "-o",
         path(&output),
@@ -115,6 +122,7 @@ fn clean_with_a_filter_and_bad_inputs() {
     let adaptive = dir.path().join("adaptive.bvh");
     let out = mocap(&[
         "clean",
+        "apply",
         &input,
         "-o",
         path(&adaptive),
@@ -130,29 +138,38 @@ fn clean_with_a_filter_and_bad_inputs() {
     );
 
     // A filter spec that does not parse is a usage error (2).
-    let out = mocap(&["clean", &input, "-o", path(&output), "--filter", "gauss:3"]);
+    let out = mocap(&[
+        "clean",
+        "apply",
+        &input,
+        "-o",
+        path(&output),
+        "--filter",
+        "gauss:3",
+    ]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 
     // A missing take is an input error (1) naming the file, and nothing is written.
     let missing = dir.path().join("missing.bvh");
     let never = dir.path().join("never.bvh");
-    let out = mocap(&["clean", path(&missing), "-o", path(&never)]);
+    let out = mocap(&["clean", "apply", path(&missing), "-o", path(&never)]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("missing.bvh"), "{}", stderr(&out));
     assert!(!never.exists());
 
     // Without -o it is a usage error.
-    let out = mocap(&["clean", &input]);
+    let out = mocap(&["clean", "apply", &input]);
     assert_eq!(out.status.code(), Some(2));
 }
 
 #[test]
-fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
+fn despike_only_leaves_a_clean_take_nearly_alone() {
     let dir = tempfile::tempdir().unwrap();
     let input = sample("dataset-1_walk_normal_001.bvh");
     let output = dir.path().join("despiked.bvh");
     let out = mocap(&[
         "clean",
+        "apply",
         &input,
         "-o",
         path(&output),
@@ -170,7 +187,7 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     let despiked = mean_channel_change(Path::new(&input), &output);
     assert!(despiked < 0.01, "despike only moved channels by {despiked}");
     let modelled = dir.path().join("modelled.bvh");
-    let out = mocap(&["clean", &input, "-o", path(&modelled), "--quiet"]);
+    let out = mocap(&["clean", "apply", &input, "-o", path(&modelled), "--quiet"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let model_change = mean_channel_change(Path::new(&input), &modelled);
     assert!(
@@ -179,10 +196,18 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     );
 
     // --despike-only needs --despike, and excludes a model or filter (usage errors).
-    let out = mocap(&["clean", &input, "-o", path(&output), "--despike-only"]);
+    let out = mocap(&[
+        "clean",
+        "apply",
+        &input,
+        "-o",
+        path(&output),
+        "--despike-only",
+    ]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let out = mocap(&[
         "clean",
+        "apply",
         &input,
         "-o",
         path(&output),
@@ -197,6 +222,7 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
     for option in ["--despike-span", "--despike-max-frames"] {
         let out = mocap(&[
             "clean",
+            "apply",
             &input,
             "-o",
             path(&output),
@@ -207,25 +233,6 @@ fn despike_only_leaves_a_clean_take_nearly_alone_and_model_kinds_are_checked() {
         assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
         assert!(stderr(&out).contains(option), "{}", stderr(&out));
     }
-
-    // A denoiser given as spike detector is an input error naming the file.
-    let model = mocap_testdata::repo_root().join("models/clean-default.safetensors");
-    let never = dir.path().join("never.bvh");
-    let out = mocap(&[
-        "clean",
-        &input,
-        "-o",
-        path(&never),
-        "--spike-model",
-        path(&model),
-    ]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("not a spike detector"),
-        "{}",
-        stderr(&out)
-    );
-    assert!(!never.exists());
 }
 
 /// `mocap clean` of the bundled walk with `model`, written to
@@ -235,6 +242,7 @@ fn clean_walk_with(model: &Path, dir: &Path) -> std::process::Output {
     let output = dir.join("clean.bvh");
     mocap(&[
         "clean",
+        "apply",
         &input,
         "-o",
         path(&output),
@@ -263,10 +271,21 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     };
     let dir = tempfile::tempdir().unwrap();
     let takes = forty_takes(dir.path(), &data);
-    // A tiny network, a few steps, the report on stdout; `extra` adds options.
+    // A tiny network (its width from a recipe), a few steps, the report on
+    // stdout; `extra` adds options.
+    let recipe = dir.path().join("tiny.toml");
+    std::fs::write(&recipe, "width = 8\n").unwrap();
     let train = |model: &Path, extra: &[&str]| {
         let mut args = vec!["clean", "train", path(&takes), "-o", path(model)];
-        args.extend(["--steps", "2", "--batch", "8", "--width", "8", "--json"]);
+        args.extend([
+            "--steps",
+            "2",
+            "--batch",
+            "8",
+            "--recipe",
+            path(&recipe),
+            "--json",
+        ]);
         args.extend(extra);
         mocap(&args)
     };
@@ -275,6 +294,7 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["history"]["epochs"].as_array().unwrap().len(), 2);
+    assert_eq!(report["description"]["network"]["width"], 8);
     assert!(model.is_file());
     assert!(model.with_extension("png").is_file());
 
@@ -306,10 +326,29 @@ fn clean_train_writes_a_model_that_clean_can_use() {
     let out = train(&based, &["--base-context", "16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("--base-filter"), "{}", stderr(&out));
+
+    // A recipe key it does not know is an input error naming the file and the key.
+    let typo = dir.path().join("typo.toml");
+    std::fs::write(&typo, "widht = 8\n").unwrap();
+    let out = mocap(&[
+        "clean",
+        "train",
+        path(&takes),
+        "-o",
+        path(&based),
+        "--recipe",
+        path(&typo),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("typo.toml") && stderr(&out).contains("widht"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
-fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
+fn clean_fit_wiener_fits_a_filter_that_apply_and_eval_use() {
     let Some(data) = mocap_testdata::shared_data() else {
         return;
     };
@@ -318,9 +357,8 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     let filter = dir.path().join("wiener.safetensors");
     let out = mocap(&[
         "clean",
-        "train",
+        "fit-wiener",
         path(&takes),
-        "--wiener",
         "-o",
         path(&filter),
         "--json",
@@ -402,9 +440,8 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     let fit_mixture = |min: &str| {
         mocap(&[
             "clean",
-            "train",
+            "fit-wiener",
             path(&takes),
-            "--wiener",
             "--mixture",
             min,
             "-o",
@@ -439,12 +476,11 @@ fn clean_train_wiener_fits_a_filter_that_clean_and_eval_use() {
     let out = fit_mixture("0");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 
-    // Network options do not go with --wiener.
+    // Network options are not fit-wiener's (usage errors).
     let out = mocap(&[
         "clean",
-        "train",
+        "fit-wiener",
         path(&takes),
-        "--wiener",
         "--epochs",
         "3",
         "-o",
@@ -649,7 +685,7 @@ fn unusable_inputs_are_refused_naming_the_file() {
     let Some(other_rig) = mocap_testdata::shared("parser-cases/bvhanim_test_mocapbank.bvh") else {
         return;
     };
-    let out = mocap(&["clean", path(&other_rig), "-o", path(&output)]);
+    let out = mocap(&["clean", "apply", path(&other_rig), "-o", path(&output)]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         stderr(&out).contains("bvhanim_test_mocapbank.bvh") && stderr(&out).contains("--filter"),
@@ -806,7 +842,15 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
     // names is refused, and the take played by the model's rig first is
     // cleaned as the original is.
     let cleaned_renamed = dir.path().join("cleaned-renamed.bvh");
-    let out = mocap(&["--rig", rig, "clean", renamed, "-o", path(&cleaned_renamed)]);
+    let out = mocap(&[
+        "--rig",
+        rig,
+        "clean",
+        "apply",
+        renamed,
+        "-o",
+        path(&cleaned_renamed),
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         stderr(&out).contains("\"Wurzel\" where the model has \"joint_Root\""),
@@ -829,7 +873,7 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
         (path(&on_bandai), &cleaned_renamed),
         (walk.as_str(), &cleaned),
     ] {
-        let out = mocap(&["clean", input, "-o", path(output)]);
+        let out = mocap(&["clean", "apply", input, "-o", path(output)]);
         assert!(out.status.success(), "{}", stderr(&out));
     }
     assert!(rotation_change_deg(&cleaned, &cleaned_renamed) < 1e-3);
@@ -974,6 +1018,7 @@ fn clean_reads_an_amc_motion_with_the_asf_beside_it() {
     let out_path = dir.path().join("clean.bvh");
     let out = mocap(&[
         "clean",
+        "apply",
         path(&amc),
         "-o",
         path(&out_path),

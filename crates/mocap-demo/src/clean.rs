@@ -4,15 +4,15 @@
 //! The model is trained on the Bandai rig (23 joints); the fused skeleton of
 //! stage 1 has another layout, so the model cannot clean it. The honest demo
 //! is on the sample: mocap-clean's chain-corrected random noise
-//! (`noise::add_random_noise_sigma`, `noise_sigma_deg` per joint) is added to
+//! (`mocap_clean::add_random_noise_sigma`, `noise_sigma_deg` per joint) is added to
 //! the take, the model cleans the noisy take, and the errors of the noisy
 //! and cleaned takes against the original are reported, with a classical
 //! filter (zero-phase Butterworth, not tuned) for reference.
 
-use mocap_clean::eval::{position_errors, rotation_error_deg};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
+use mocap_clean::{
+    add_random_noise_sigma, filter_motion, position_errors, rotation_error_deg, CleanModel, Filter,
+    RandomNoise,
+};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::angle_between;
 use mocap_core::Motion;

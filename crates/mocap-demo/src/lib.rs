@@ -58,7 +58,7 @@ const EMBEDDED: &[(&str, &[u8])] = &[
     ),
     (
         "models/clean-default.safetensors",
-        mocap_clean::infer::DEFAULT_MODEL,
+        mocap_clean::DEFAULT_MODEL,
     ),
     (
         "models/style-default.safetensors",

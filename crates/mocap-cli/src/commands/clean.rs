@@ -1,53 +1,46 @@
-//! `mocap clean`: denoise a take with the learned model or a classical filter,
-//! train a denoiser, evaluate methods (all in `mocap-clean`).
-//!
-//! `mocap clean IN -o OUT` cleans one take; `mocap clean train` and
-//! `mocap clean eval` are subcommands. A take literally named `train` or
-//! `eval` can be cleaned as `mocap clean ./train -o OUT`.
+//! `mocap clean`: denoise a take with the learned model or a classical filter
+//! (`apply`), train a network (`train`), fit a learned Wiener filter
+//! (`fit-wiener`), evaluate methods (`eval`); all in `mocap-clean`.
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
-use mocap_clean::despike::DespikeOptions;
-use mocap_clean::eval::{evaluate, EvalOptions, ModelEntry};
-use mocap_clean::features::{Representation, RotationFrame};
-use mocap_clean::filters::Filter;
-use mocap_clean::infer::{clean_file, BridgedSpike, CleanOptions, FindSpikes, Method};
-use mocap_clean::model::DenoiserConfig;
-use mocap_clean::spikes::SpikeOptions;
-use mocap_clean::training::{train, TrainOptions};
-use mocap_clean::wiener::{fit_files, WienerFitOptions};
-use mocap_nn::device::DeviceChoice;
+use anyhow::anyhow;
+use mocap_clean::{
+    clean_file, evaluate, fit_wiener, parse_spike_lengths, train, BridgedSpike, CleanOptions,
+    DespikeOptions, EvalOptions, Filter, Method, ModelEntry, Representation, RotationFrame,
+    TrainOptions, TrainRecipe, WienerFitOptions,
+};
 
+use super::args::{set, DeviceArgs, ReportArgs, TrainLoopArgs};
 use super::{write_output, GlobalOptions};
 
 #[derive(clap::Args)]
-#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
     #[command(subcommand)]
-    command: Option<CleanCommand>,
-    #[command(flatten)]
-    take: TakeArgs,
+    command: CleanCommand,
 }
 
 #[derive(clap::Subcommand)]
 enum CleanCommand {
-    /// Train a denoiser on clean takes with synthetic markerless noise.
-    Train(Box<TrainArgs>),
+    /// Clean a take with the shipped model, a model file or a classical filter.
+    Apply(CleanApplyArgs),
+    /// Train a network on clean takes with synthetic markerless noise.
+    Train(Box<CleanTrainArgs>),
+    /// Fit a learned multichannel Wiener filter (or a mixture of them) to clean takes.
+    FitWiener(FitWienerArgs),
     /// Noisy input, tuned filters and models on held-out takes: rotation, position and acceleration errors.
-    Eval(EvalArgs),
+    Eval(CleanEvalArgs),
 }
 
-/// `mocap clean IN -o OUT`.
+/// `mocap clean apply IN -o OUT`.
 #[derive(clap::Args)]
-struct TakeArgs {
+struct CleanApplyArgs {
     /// The take to clean (BVH).
-    #[arg(required = true)]
-    input: Option<PathBuf>,
+    input: PathBuf,
     /// The cleaned take (BVH: same skeleton and channel layout, root translation kept).
-    #[arg(long, short, required = true)]
-    output: Option<PathBuf>,
-    /// A file written by `mocap clean train`: a network, or a Wiener filter (`--wiener`)
+    #[arg(long, short)]
+    output: PathBuf,
+    /// A file written by `mocap clean train` or `mocap clean fit-wiener`
     /// (default: the model shipped with mocap).
     #[arg(long, conflicts_with = "filter")]
     model: Option<PathBuf>,
@@ -55,9 +48,8 @@ struct TakeArgs {
     /// butterworth-gcv:ORDER (cutoff chosen per channel from the take itself), savitzky-golay:WINDOW:POLYORDER, median:WINDOW or one-euro:MIN_HZ:BETA:D_HZ.
     #[arg(long, value_name = "SPEC")]
     filter: Option<Filter>,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
+    #[command(flatten)]
+    device: DeviceArgs,
     /// Frames between window starts (default: a quarter window).
     #[arg(long)]
     hop: Option<usize>,
@@ -79,44 +71,28 @@ struct TakeArgs {
     /// Spike finding: the longest spike looked for, in frames (default 90).
     #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
     despike_max_frames: Option<usize>,
-    /// Before cleaning, find spikes (a joint and its subtree taking another motion's rotations) with
-    /// this learned detector, written by `mocap clean train --spike-detector`, and bridge them.
-    /// Experimental, none ships: see bench/results/clean.md.
-    #[arg(long, value_name = "FILE")]
-    spike_model: Option<PathBuf>,
-    /// Probability from which the detector's marks are bridged (default 0.5).
-    #[arg(long, requires = "spike_model")]
-    spike_threshold: Option<f32>,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
 }
 
+/// `mocap clean train DIR... -o model.safetensors`.
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("base").args(["base_filter", "base_wiener"])))]
-struct TrainArgs {
+struct CleanTrainArgs {
     /// Folders or files of clean BVH takes (split by take into train / validation / test).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     /// The model file to write (safetensors).
     #[arg(long, short)]
     output: PathBuf,
-    /// Training epochs (default 20).
-    #[arg(long)]
-    epochs: Option<usize>,
-    /// Training steps per epoch.
-    #[arg(long)]
-    steps: Option<usize>,
-    /// Windows per step (report: 512).
-    #[arg(long)]
-    batch: Option<usize>,
-    /// Adam learning rate (report: 1e-3).
-    #[arg(long)]
-    lr: Option<f64>,
-    /// Seed of the weights, the windows drawn and the noise (default 1): the same seed and data
-    /// give the same model.
-    #[arg(long)]
-    seed: Option<u64>,
+    #[command(flatten)]
+    train_loop: TrainLoopArgs,
+    /// The network's shape and the synthetic spikes' settings as TOML (keys: large, width, levels,
+    /// blocks, window, spike_probability, max_spikes, spike_sigma; each optional). The shipped
+    /// network's: crates/mocap-clean/recipes/shipped-network.toml.
+    #[arg(long, value_name = "FILE.toml")]
+    recipe: Option<PathBuf>,
     /// `derivative` (rotation + velocity + acceleration terms, alpha = dt^2, beta = dt^4) or `mse`.
     #[arg(long, default_value = "derivative", value_parser = ["derivative", "mse"])]
     loss: String,
@@ -127,8 +103,8 @@ struct TrainArgs {
     /// `pelvis` (relative to the pelvis; see bench/results/clean.md).
     #[arg(long)]
     rotations: Option<RotationFrame>,
-    /// A classical filter (same SPEC as `mocap clean --filter`) whose output the network corrects,
-    /// instead of correcting its input (see bench/results/clean.md).
+    /// A classical filter (same SPEC as `mocap clean apply --filter`) whose output the network
+    /// corrects, instead of correcting its input (see bench/results/clean.md).
     #[arg(long, value_name = "SPEC")]
     base_filter: Option<Filter>,
     /// With --base-filter or --base-wiener: frames of the take the filter sees on each side of a training window;
@@ -136,9 +112,9 @@ struct TrainArgs {
     /// needs a long stretch to be chosen well). 0: each window alone.
     #[arg(long, value_name = "FRAMES", requires = "base")]
     base_context: Option<usize>,
-    /// A Wiener filter (from `mocap clean train --wiener`) whose output the network corrects, instead
+    /// A Wiener filter (from `mocap clean fit-wiener`) whose output the network corrects, instead
     /// of a classical --base-filter; the model file then holds both. Use with --base-context.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["base_filter", "spike_detector", "position_weight"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["base_filter", "position_weight"])]
     base_wiener: Option<PathBuf>,
     /// With --base-wiener: the network also reads the filter's output and the noise level it
     /// estimated, and scales its correction by that level, so it leaves a clean take alone (see
@@ -148,21 +124,6 @@ struct TrainArgs {
     /// Weight of the joint-position term added to the loss (0: off; see bench/results/clean.md).
     #[arg(long)]
     position_weight: Option<f32>,
-    /// The report's large network (for a GPU) instead of the small default.
-    #[arg(long)]
-    large: bool,
-    /// Channels of the first level.
-    #[arg(long)]
-    width: Option<usize>,
-    /// Times the network halves the time axis.
-    #[arg(long)]
-    levels: Option<usize>,
-    /// Residual blocks per level.
-    #[arg(long)]
-    blocks: Option<usize>,
-    /// Window length in frames (report: 16).
-    #[arg(long)]
-    window: Option<usize>,
     /// Largest standard deviation of the random noise, degrees (report: 10).
     #[arg(long, value_name = "MAX", value_parser = degrees_at_least_zero)]
     max_sigma: Option<f32>,
@@ -170,65 +131,56 @@ struct TrainArgs {
     /// `joint_Root` on the floor; off by default, see bench/results/clean.md).
     #[arg(long)]
     noise_above_pelvis: bool,
-    /// Probability that a training window gets spikes.
-    #[arg(long)]
-    spike_probability: Option<f32>,
-    /// At most this many simultaneous spikes (report: 3).
-    #[arg(long)]
-    max_spikes: Option<usize>,
-    /// Standard deviation of a spike's duration in frames (report: 16).
-    #[arg(long)]
-    spike_sigma: Option<f32>,
     /// Train on at most this many takes (quick runs).
     #[arg(long)]
     max_train_takes: Option<usize>,
     /// Folder of the resumable training state (default: OUTPUT.state).
     #[arg(long)]
     state: Option<PathBuf>,
-    /// Continue an interrupted run from its state folder.
-    #[arg(long)]
-    resume: bool,
-    /// Train a spike detector (for `mocap clean --spike-model`) instead of a denoiser:
-    /// the same network with one output per joint and frame, trained to mark the synthetic spikes.
-    #[arg(long, conflicts_with_all = ["base_filter", "position_weight"])]
-    spike_detector: bool,
-    /// Fit a learned multichannel Wiener filter instead of training a network (a minute, not
-    /// twenty: the spectra of the clean training takes and the covariance of the random noise;
-    /// `mocap clean --model` and `mocap clean eval --model` take the file; see
-    /// bench/results/clean.md).
-    #[arg(long, conflicts_with_all = [
-        "spike_detector", "base_filter", "resume", "large", "epochs", "steps", "batch", "lr",
-        "representation", "rotations", "position_weight", "width", "levels", "blocks", "window",
-        "max_sigma", "spike_probability", "max_spikes", "spike_sigma", "plot", "state", "base_wiener",
-        "base_context", "base_input",
-    ])]
-    wiener: bool,
-    /// With --wiener: frames per Fourier segment (default 32).
-    #[arg(long, value_name = "FRAMES", requires = "wiener")]
-    segment: Option<usize>,
-    /// With --wiener: fit a mixture, one set of spectra per content named in the file names
-    /// (`<set>_<content>_<style>_<take>`) with at least this many training segments (150 for the
-    /// shipped one), plus one for the rest and one for all; each take is cleaned with the one
-    /// that fits it best.
-    #[arg(long, value_name = "MIN_SEGMENTS", requires = "wiener", value_parser = clap::value_parser!(u32).range(1..))]
-    mixture: Option<u32>,
-    /// With --mixture: build the mixture from the Wiener filter this network model corrects and
-    /// write the network (not retrained) with the mixture under it.
-    #[arg(long, value_name = "MODEL", requires = "mixture")]
-    rebase: Option<PathBuf>,
-    /// Training and validation curves as PNG (default: OUTPUT with extension png).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
 }
 
+/// `mocap clean fit-wiener DIR... -o wiener.safetensors`.
 #[derive(clap::Args)]
-struct EvalArgs {
+struct FitWienerArgs {
+    /// Folders or files of clean BVH takes (the training split is used).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// The Wiener filter (or, with --rebase, the network on the mixture) to write (safetensors).
+    #[arg(long, short)]
+    output: PathBuf,
+    /// Frames per Fourier segment (default 32).
+    #[arg(long, value_name = "FRAMES")]
+    segment: Option<usize>,
+    /// Fit a mixture, one set of spectra per content named in the file names
+    /// (`<set>_<content>_<style>_<take>`) with at least this many training segments (150 for the
+    /// shipped one), plus one for the rest and one for all; each take is cleaned with the one
+    /// that fits it best.
+    #[arg(long, value_name = "MIN_SEGMENTS", value_parser = clap::value_parser!(u32).range(1..))]
+    mixture: Option<u32>,
+    /// With --mixture: build the mixture from the Wiener filter this network model corrects and
+    /// write the network (not retrained) with the mixture under it.
+    #[arg(long, value_name = "MODEL", requires = "mixture")]
+    rebase: Option<PathBuf>,
+    /// Seed of the noise the noise covariance is measured on.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Also put random noise on the joints above the pelvis (see bench/results/clean.md).
+    #[arg(long)]
+    noise_above_pelvis: bool,
+    /// Fit to at most this many takes (quick runs).
+    #[arg(long)]
+    max_train_takes: Option<usize>,
+    /// Print the report as JSON on standard output.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `mocap clean eval DIR...`.
+#[derive(clap::Args)]
+struct CleanEvalArgs {
     /// Folders or files of clean BVH takes.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
@@ -246,10 +198,6 @@ struct EvalArgs {
     /// validation takes).
     #[arg(long)]
     despike: bool,
-    /// Also run this learned spike detector (from `mocap clean train --spike-detector`) alone and
-    /// before the first filter and every model.
-    #[arg(long, value_name = "FILE")]
-    spike_model: Option<PathBuf>,
     /// Evaluate every take, not only the test split (for data the models were not trained on);
     /// the filters and spike finding are then tuned on the first --tune-takes of those same takes,
     /// which flatters them (the report says so).
@@ -272,34 +220,26 @@ struct EvalArgs {
     /// [0, MAX] (default: the report's 10; 0 measures what a method does to clean takes).
     #[arg(long, value_name = "MAX", value_parser = degrees_at_least_zero)]
     max_sigma: Option<f32>,
-    /// Seed of the noise put on the takes (default 1): the same seed gives the same figures.
+    /// Seed of the noise put on the takes (default 7, the seed of the published figures): the same
+    /// seed gives the same figures.
     #[arg(long)]
     seed: Option<u64>,
-    /// cpu, or cuda[:N] in a build with the `cuda` feature.
-    #[arg(long, default_value = "cpu")]
-    device: DeviceChoice,
-    /// Also write the Markdown tables to this file.
-    #[arg(long)]
-    markdown: Option<PathBuf>,
-    /// Print the report as JSON (one entry per method and noise condition) instead of Markdown.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    device: DeviceArgs,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     match args.command {
-        Some(CleanCommand::Train(a)) => run_train(*a, options),
-        Some(CleanCommand::Eval(a)) => run_eval(a),
-        None => run_clean(args.take, options),
+        CleanCommand::Apply(a) => run_apply(a, options),
+        CleanCommand::Train(a) => run_train(*a, options),
+        CleanCommand::FitWiener(a) => run_fit_wiener(a, options),
+        CleanCommand::Eval(a) => run_eval(a),
     }
 }
 
-fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
-    // clap enforces both (`required = true`); the options only exist so that
-    // the subcommands can go without them.
-    let (Some(input), Some(output)) = (a.input, a.output) else {
-        bail!("mocap clean needs a take and -o OUTPUT");
-    };
+fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     let method = match (a.model, a.filter) {
         _ if a.despike_only => Method::SpikesOnly,
         (Some(model), _) => Method::Model(model),
@@ -313,20 +253,13 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         set(&mut d.max_frames, a.despike_max_frames);
         d
     });
-    let find_spikes = a.spike_model.map(|model| {
-        let mut options = SpikeOptions::default();
-        set(&mut options.threshold, a.spike_threshold);
-        FindSpikes { model, options }
-    });
-    let find_spikes_asked = find_spikes.is_some();
     let report = clean_file(&CleanOptions {
-        input,
-        output,
+        input: a.input,
+        output: a.output,
         method,
-        device: a.device,
+        device: a.device.device,
         hop: a.hop,
         despike,
-        find_spikes,
     })?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -339,89 +272,72 @@ fn run_clean(a: TakeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             report.mean_change_deg,
             report.frames_per_second
         );
-        const LISTED: usize = 20;
-        let list = |spikes: &[BridgedSpike]| {
-            if spikes.len() > LISTED {
-                eprintln!(
-                    "  (the first {LISTED} of {}; --json lists them all)",
-                    spikes.len()
-                );
-            }
-            for s in spikes.iter().take(LISTED) {
-                eprintln!(
-                    "  {} and below: frames {}-{} ({:.2}-{:.2} s)",
-                    s.joint,
-                    s.start,
-                    s.start + s.frames - 1,
-                    s.start_seconds,
-                    s.start_seconds + s.seconds
-                );
-            }
-        };
-        // With --despike-only nothing is cleaned after the bridging.
-        let when = if a.despike_only {
-            "(no cleaning after)"
-        } else {
-            "before cleaning"
-        };
-        if find_spikes_asked {
-            eprintln!(
-                "spike detector: bridged {} spikes {when}",
-                report.detected_spikes.len()
-            );
-            list(&report.detected_spikes);
-        }
         if a.despike {
+            // With --despike-only nothing is cleaned after the bridging.
+            let when = if a.despike_only {
+                "(no cleaning after)"
+            } else {
+                "before cleaning"
+            };
             eprintln!("bridged {} spikes {when}", report.spikes.len());
-            list(&report.spikes);
+            list_spikes(&report.spikes);
         }
     }
     Ok(())
 }
 
-fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
-    if a.wiener {
-        return run_fit_wiener(a, options);
+/// The first bridged spikes, one line each, on standard error.
+fn list_spikes(spikes: &[BridgedSpike]) {
+    const LISTED: usize = 20;
+    if spikes.len() > LISTED {
+        eprintln!(
+            "  (the first {LISTED} of {}; --json lists them all)",
+            spikes.len()
+        );
     }
+    for s in spikes.iter().take(LISTED) {
+        eprintln!(
+            "  {} and below: frames {}-{} ({:.2}-{:.2} s)",
+            s.joint,
+            s.start,
+            s.start + s.frames - 1,
+            s.start_seconds,
+            s.start_seconds + s.seconds
+        );
+    }
+}
+
+fn run_train(a: CleanTrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    let l = a.train_loop;
     let mut o = TrainOptions {
         inputs: a.inputs,
         out: a.output,
         state_dir: a.state,
-        resume: a.resume,
-        plot: a.plot,
-        device: a.device,
+        resume: l.resume,
+        plot: l.plot,
+        device: l.device.device,
+        seed: l.seed,
         max_train_takes: a.max_train_takes,
         derivative_loss: a.loss == "derivative",
-        spike_detector: a.spike_detector,
+        base_filter: a.base_filter,
+        base_wiener: a.base_wiener,
+        base_input: a.base_input,
         ..TrainOptions::default()
     };
-    if a.large {
-        o.network = DenoiserConfig::large(0);
+    if let Some(path) = &a.recipe {
+        TrainRecipe::load(path)?.apply_to(&mut o);
     }
-    set(&mut o.epochs, a.epochs);
-    set(&mut o.steps_per_epoch, a.steps);
-    set(&mut o.batch_size, a.batch);
-    set(&mut o.learning_rate, a.lr);
-    set(&mut o.seed, a.seed);
+    set(&mut o.epochs, l.epochs);
+    set(&mut o.steps_per_epoch, l.steps);
+    set(&mut o.batch_size, l.batch);
+    set(&mut o.learning_rate, l.lr);
     set(&mut o.representation, a.representation);
     set(&mut o.frame, a.rotations);
-    o.base_filter = a.base_filter;
-    o.base_wiener = a.base_wiener;
-    o.base_input = a.base_input;
     set(&mut o.base_context, a.base_context);
     set(&mut o.position_weight, a.position_weight);
-    set(&mut o.network.width, a.width);
-    set(&mut o.network.levels, a.levels);
-    set(&mut o.network.blocks, a.blocks);
-    set(&mut o.network.window, a.window);
-    set(&mut o.noise.spike_probability, a.spike_probability);
     if let Some(random) = o.noise.random.as_mut() {
         set(&mut random.max_sigma_deg, a.max_sigma);
         random.perturb_above_pelvis |= a.noise_above_pelvis;
-    }
-    if let Some(spikes) = o.noise.spikes.as_mut() {
-        set(&mut spikes.max_spikes, a.max_spikes);
-        set(&mut spikes.duration_sigma_frames, a.spike_sigma);
     }
     let report = train(&o)?;
     if a.json {
@@ -438,12 +354,13 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         );
         // The report's network on its own is not the shipped recipe, and
         // measured behind a per-take Butterworth: say so where it is made.
-        if o.base_wiener.is_none() && o.base_filter.is_none() && !o.spike_detector {
+        if o.base_wiener.is_none() && o.base_filter.is_none() {
             eprintln!(
                 "note: this is the report's network alone; on the Bandai test takes it measured \
                  behind `--filter butterworth-gcv:2` (bench/results/clean.md). The shipped model \
-                 corrects a Wiener filter: `mocap clean train DIR --wiener -o wiener.safetensors`, \
-                 then `--base-wiener wiener.safetensors --base-context 128 --base-input` \
+                 corrects a Wiener filter: `mocap clean fit-wiener DIR -o wiener.safetensors`, \
+                 then `--base-wiener wiener.safetensors --base-context 128 --base-input \
+                 --recipe crates/mocap-clean/recipes/shipped-network.toml` \
                  (docs/clean-guide.md, \"Training your own Wiener filter or model\")"
             );
         }
@@ -451,24 +368,24 @@ fn run_train(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run_fit_wiener(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+fn run_fit_wiener(a: FitWienerArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     let mut o = WienerFitOptions {
         inputs: a.inputs,
         out: a.output,
         max_train_takes: a.max_train_takes,
+        seed: a.seed,
+        mixture_min_segments: a.mixture.map(|m| m as usize),
+        rebase: a.rebase,
         ..WienerFitOptions::default()
     };
     set(&mut o.segment, a.segment);
-    set(&mut o.seed, a.seed);
-    o.mixture_min_segments = a.mixture.map(|m| m as usize);
-    o.rebase = a.rebase;
     o.noise.perturb_above_pelvis |= a.noise_above_pelvis;
     if !options.quiet && !a.json {
         eprintln!(
             "fitting a Wiener filter to the training takes (about a minute for the Bandai data)"
         );
     }
-    let report = fit_files(&o)?;
+    let report = fit_wiener(&o)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else if !options.quiet {
@@ -495,73 +412,41 @@ fn run_fit_wiener(a: TrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run_eval(a: EvalArgs) -> anyhow::Result<()> {
+fn run_eval(a: CleanEvalArgs) -> anyhow::Result<()> {
     let mut o = EvalOptions {
         inputs: a.inputs,
         test_split_only: !a.all_takes,
         filters: !a.no_filters,
         max_takes: a.max_takes,
-        device: a.device,
+        device: a.device.device,
+        despike: a.despike,
         ..EvalOptions::default()
     };
     o.random.perturb_above_pelvis = a.noise_above_pelvis;
     set(&mut o.random.max_sigma_deg, a.max_sigma);
-    o.despike = a.despike;
-    o.spike_detector = a.spike_model.map(|path| ModelEntry {
-        label: "spike detector".into(),
-        path: Some(path),
-    });
     if a.no_default_model {
         o.models.retain(|m| m.path.is_some());
     }
     for text in &a.models {
-        let (label, path) = text.split_once('=').unwrap_or((text, text));
-        if path.is_empty() {
-            bail!("--model {text:?}: expected LABEL=FILE or FILE");
-        }
-        o.models.push(ModelEntry {
-            label: label.into(),
-            path: Some(PathBuf::from(path)),
-        });
+        let entry: ModelEntry = text.parse().map_err(|e| anyhow!("--model {e}"))?;
+        o.models.push(entry);
     }
     set(&mut o.tune_takes, a.tune_takes);
     set(&mut o.seed, a.seed);
     if let Some(text) = &a.spike_lengths {
-        o.spike_lengths = parse_lengths(text)?;
-    }
-    if o.models.is_empty() && !o.filters {
-        bail!("nothing to evaluate: --no-default-model and --no-filters with no --model");
+        o.spike_lengths = parse_spike_lengths(text).map_err(|e| anyhow!("--spike-lengths {e}"))?;
     }
     let report = evaluate(&o)?;
     let markdown = report.to_markdown();
-    if let Some(path) = &a.markdown {
+    if let Some(path) = &a.report.markdown {
         write_output(Some(path), |w| w.write_all(markdown.as_bytes()))?;
     }
-    let text = if a.json {
+    let text = if a.report.json {
         serde_json::to_string_pretty(&report)? + "\n"
     } else {
         markdown
     };
     write_output(None, |w| w.write_all(text.as_bytes()))
-}
-
-/// `2,4,8` or `none`.
-fn parse_lengths(text: &str) -> anyhow::Result<Vec<usize>> {
-    if text.trim() == "none" {
-        return Ok(Vec::new());
-    }
-    text.split(',')
-        .filter(|s| !s.trim().is_empty())
-        .map(|s| {
-            let n: usize = s.trim().parse().with_context(|| {
-                format!("--spike-lengths {text:?}: expected frame counts like 2,4,8 or none")
-            })?;
-            if n == 0 {
-                bail!("--spike-lengths {text:?}: a spike lasts at least one frame");
-            }
-            Ok(n)
-        })
-        .collect()
 }
 
 /// Parses a noise level: a finite number of degrees, zero or more.
@@ -581,12 +466,5 @@ fn frames_at_least_one(text: &str) -> Result<usize, String> {
         _ => Err(format!(
             "expected a number of frames, 1 or more, got `{text}`"
         )),
-    }
-}
-
-/// Overrides a default when the option was given.
-fn set<T>(slot: &mut T, value: Option<T>) {
-    if let Some(v) = value {
-        *slot = v;
     }
 }

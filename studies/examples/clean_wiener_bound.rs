@@ -1,4 +1,4 @@
-//! Study: the learned multichannel Wiener filter ([`mocap_clean::wiener`])
+//! Study: the learned multichannel Wiener filter ([`mocap_clean::WienerFilter`])
 //! against the cross-validated Butterworth, on validation takes with random
 //! noise of fixed sigma.
 //!
@@ -10,18 +10,17 @@
 //! with the sigma it estimates (marginal likelihood), and the mean
 //! estimated sigma.
 //!
-//! cargo run --profile test -p mocap-clean --example wiener_bound -- DATA [TAKES] [SIGMAS] [SEGMENT]
+//! cargo run --release -p mocap-studies --example clean_wiener_bound -- DATA [TAKES] [SIGMAS] [SEGMENT]
 
-mod support;
+use mocap_studies::clean as support;
 
 use std::time::Instant;
 
-use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::features::{FeatureLayout, Representation};
-use mocap_clean::filters::{filter_features, filter_motion, Filter};
-use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
-use mocap_clean::wiener::WienerFilter;
+use mocap_clean::{
+    add_random_noise_sigma, filter_features, filter_motion, list_bvh, load_takes, paths_in_split,
+    rotation_error_deg, FeatureLayout, Filter, RandomNoise, Representation, Split, SplitFractions,
+    WienerFilter,
+};
 use mocap_core::Motion;
 use nalgebra::{DMatrix, SymmetricEigen};
 use rand::rngs::ChaCha8Rng;

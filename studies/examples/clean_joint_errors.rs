@@ -1,10 +1,9 @@
 //! Per-joint rotation error of a model on one take, clean and noisy (a
 //! diagnostic).
 //!
-//! cargo run -p mocap-clean --example joint_errors -- TAKE.bvh [MODEL]
+//! cargo run --release -p mocap-studies --example clean_joint_errors -- TAKE.bvh [MODEL]
 
-use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
+use mocap_clean::{add_random_noise_sigma, CleanModel, RandomNoise};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::joint_rotation_errors_degrees;
 use rand::SeedableRng;

@@ -13,18 +13,18 @@
 //!   clean take). Errors over every joint with rotation channels and over
 //!   the joints of body parts.
 //! - `--fps F`: each take resampled to F frames per second first; the
-//!   model reading its frames as they are (what `mocap clean` does: the
+//!   model reading its frames as they are (what `mocap clean apply` does: the
 //!   model reads frames, not seconds), and with the take resampled to the
 //!   model's 30 fps and back.
 //!
-//! cargo run --profile test -p mocap-clean --example foreign_rig_eval -- DATA (RIG.bvh | --fps F) [TAKES]
+//! cargo run --release -p mocap-studies --example clean_foreign_rig_eval -- DATA (RIG.bvh | --fps F) [TAKES]
 
 use std::path::PathBuf;
 
-use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::{CleanModel, ModelFile};
-use mocap_clean::noise::{add_random_noise, RandomNoise};
+use mocap_clean::{
+    add_random_noise, filter_motion, list_bvh, load_takes, paths_in_split, CleanModel, Filter,
+    ModelFile, RandomNoise, Split, SplitFractions,
+};
 use mocap_core::bodymap::BodyMap;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::joint_rotation_errors_degrees;
@@ -80,7 +80,7 @@ fn main() -> Result<(), Error> {
     labels.push(if rig.is_some() {
         "shipped model through retargeting"
     } else {
-        "shipped model reading the frames as they are (mocap clean)"
+        "shipped model reading the frames as they are (mocap clean apply)"
     });
     if fps.is_some() {
         labels.push("shipped model, the take resampled to 30 fps and back");

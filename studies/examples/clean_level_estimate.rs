@@ -1,10 +1,10 @@
 //! Study: the take's noise level as the median of its segments' levels
 //! ([`LevelEstimate::SegmentMedian`]) against the level of all segments
-//! together ([`LevelEstimate::Pooled`], sessions 7-22), with the shipped
+//! together ([`LevelEstimate::Pooled`]), with the shipped
 //! model.
 //!
 //! On the test takes, for each noise draw (the evaluation's conditions,
-//! [`mocap_clean::eval::noisy_take`], seed 7 being the evaluation's own):
+//! [`mocap_clean::noisy_take`], seed 7 being the evaluation's own):
 //! random noise, the model; spikes on random noise, spikes found and
 //! bridged (the default finder), then the model; spikes alone, the same;
 //! and once, the clean takes themselves and takes with at most 2 degrees of
@@ -14,16 +14,14 @@
 //! 3 frames, and spike finding alone). Mean rotation error in degrees,
 //! frame-weighted, and the mean level the model's Wiener filter estimated.
 //!
-//! cargo run --profile test -p mocap-clean --example level_estimate -- DATA [SEEDS]
+//! cargo run --release -p mocap-studies --example clean_level_estimate -- DATA [SEEDS]
 
-mod support;
+use mocap_studies::clean as support;
 
-use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions};
-use mocap_clean::eval::{noisy_take, rotation_error_deg, EvalOptions};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::CleanModel;
-use mocap_clean::noise::RandomNoise;
-use mocap_clean::wiener::LevelEstimate;
+use mocap_clean::{
+    bridge_spikes, filter_motion, find_spikes, noisy_take, rotation_error_deg, CleanModel,
+    DespikeOptions, EvalOptions, Filter, LevelEstimate, RandomNoise,
+};
 use mocap_core::Motion;
 use rayon::prelude::*;
 
@@ -83,8 +81,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     println!(
         "{} test takes, {frames} frames. Mean rotation error (degrees) of the shipped model with the \
-         take's noise level pooled over its segments (sessions 7-22) and as the median of its \
-         segments' levels (session 23); in brackets the mean level estimated (degrees).\n",
+         take's noise level pooled over its segments and as the median of its segments' levels \
+         (the default); in brackets the mean level estimated (degrees).\n",
         takes.len()
     );
     println!(

@@ -5,7 +5,7 @@
 //! On validation takes with the spike studies' noise (random noise drawn in
 //! 0-10 degrees, 1-3 spikes; `support::spiked_take`), the finder's spikes
 //! are bridged in the input and the shipped model runs, as
-//! `mocap clean --despike` does, for the finder of sessions 9-21 (every
+//! `mocap clean apply --despike` does, for the own-jump finder (every
 //! joint judged by its own jump as well as its subtree's) and the default
 //! (trunk joints judged by their subtree's jump alone,
 //! [`DespikeOptions::trunk_by_subtree`]). Beside each, every found spike that
@@ -17,16 +17,16 @@
 //! Printed: the mean rotation error of each, where found spikes sit against
 //! the true ones, and the missed spikes' error by joint.
 //!
-//! cargo run --profile test -p mocap-clean --example spike_attribution -- DATA [TAKES]
+//! cargo run --release -p mocap-studies --example clean_spike_attribution -- DATA [TAKES]
 
-mod support;
+use mocap_studies::clean as support;
 
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions, FoundSpike};
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::infer::CleanModel;
+use mocap_clean::{
+    bridge_spikes, find_spikes, rotation_error_deg, CleanModel, DespikeOptions, FoundSpike,
+};
 use mocap_core::rotation::{angle_between, mean_of_close, slerp};
 use mocap_core::{Motion, Skeleton};
 use rayon::prelude::*;
@@ -118,7 +118,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let takes = args.validation_takes()?;
     let finders = [
         (
-            "sessions 9-21 (own jump too)",
+            "own jump too",
             DespikeOptions {
                 trunk_by_subtree: false,
                 ..DespikeOptions::default()

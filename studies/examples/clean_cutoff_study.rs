@@ -9,14 +9,14 @@
 //! chosen with the clean take in hand (oracles: how far choosing the cutoff
 //! better could take a Butterworth at all).
 //!
-//! cargo run --profile test -p mocap-clean --example cutoff_study -- DATA [TAKES] [SIGMAS]
+//! cargo run --release -p mocap-studies --example clean_cutoff_study -- DATA [TAKES] [SIGMAS]
 
-mod support;
+use mocap_studies::clean as support;
 
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::features::{FeatureLayout, Representation};
-use mocap_clean::filters::{filter_features, gcv_score, gcv_trace_fraction, Filter};
-use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
+use mocap_clean::{
+    add_random_noise_sigma, filter_features, gcv_score, gcv_trace_fraction, rotation_error_deg,
+    FeatureLayout, Filter, RandomNoise, Representation,
+};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;
@@ -70,7 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let oracle = row[1..].iter().cloned().fold(f64::INFINITY, f64::min);
                 row.push(oracle);
                 let dim = 6;
-                // GCV (`mocap_clean::filters::gcv_score`) of cutoff `k` over
+                // GCV (`mocap_clean::gcv_score`) of cutoff `k` over
                 // the channels `ch`, for choices coarser than the filter's
                 // own per-channel one.
                 let score = |k: usize, ch: std::ops::Range<usize>| {

@@ -19,13 +19,11 @@
 //!   output: the mean step of `find_spikes` over its quartile, or the step
 //!   between lines fitted on each side (over the take's median, or raw).
 //!
-//! cargo run --profile test -p mocap-clean --example spike_boundaries -- DATA [TAKES]
+//! cargo run --release -p mocap-studies --example clean_spike_boundaries -- DATA [TAKES]
 
-mod support;
+use mocap_studies::clean as support;
 
-use mocap_clean::despike::normalised_jumps;
-use mocap_clean::features::{FeatureLayout, Representation};
-use mocap_clean::infer::CleanModel;
+use mocap_clean::{normalised_jumps, CleanModel, FeatureLayout, Representation};
 use mocap_core::rotation::{angle_between, expmap_to_quat, quat_to_expmap};
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, Motion};
@@ -232,7 +230,7 @@ fn point_step(points: &[Vec<Vec3>], t: usize, span: usize) -> f32 {
 /// Subtree-level: positives are (boundary, spike joint) of true spikes that
 /// turn some joint of the subtree by >= 20 degrees; negatives are (t, j) more
 /// than 6 frames from any boundary of a spike on j, a joint above or below.
-fn subtree_level(takes: &[mocap_clean::dataset::Take], model: &CleanModel) {
+fn subtree_level(takes: &[mocap_clean::Take], model: &CleanModel) {
     let names = [
         "rotations (model output, span 3): subtree median of normalised jumps",
         "rotations (input, span 2): subtree median of normalised jumps",

@@ -1,12 +1,12 @@
 //! Study: how much do the evaluation's spike figures depend on its one noise
-//! draw, and does the default spike finder beat the one of sessions 9-21
-//! over several draws?
+//! draw, and does the default spike finder beat the own-jump finder (trunk
+//! joints judged by their own jump too) over several draws?
 //!
 //! On the test takes, the evaluation's spike conditions
-//! ([`mocap_clean::eval::noisy_take`]) are drawn again with other seeds
+//! ([`mocap_clean::noisy_take`]) are drawn again with other seeds
 //! (the evaluation's own is 7). For each draw: spikes found (the default
-//! finder, trunk joints judged by their subtree alone; and the finder of
-//! sessions 9-21, every joint by its own jump too) and bridged, then the
+//! finder, trunk joints judged by their subtree alone; and the own-jump
+//! finder, every joint by its own jump too) and bridged, then the
 //! shipped model; the two Butterworth references of the issue's target (the
 //! best fixed one on this condition, 2 Hz, and the per-take cross-validated
 //! one); the true spikes bridged, then the model (the oracle); and on spikes
@@ -14,18 +14,18 @@
 //! filter of the evaluation on that condition (a running median of 3 frames).
 //! Mean rotation error in degrees, frame-weighted.
 //!
-//! cargo run --profile test -p mocap-clean --example spike_draws -- DATA [SEEDS]
+//! cargo run --release -p mocap-studies --example clean_spike_draws -- DATA [SEEDS]
 
-mod support;
+use mocap_studies::clean as support;
 
-use mocap_clean::despike::{bridge_spikes, find_spikes, DespikeOptions, FoundSpike};
-use mocap_clean::eval::{noisy_take, rotation_error_deg};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::CleanModel;
+use mocap_clean::{
+    bridge_spikes, filter_motion, find_spikes, noisy_take, rotation_error_deg, CleanModel,
+    DespikeOptions, Filter, FoundSpike,
+};
 
-/// Columns: spikes on random noise (finder + model: default, sessions 9-21;
+/// Columns: spikes on random noise (finder + model: default, own-jump;
 /// Butterworth 2 Hz, cross-validated Butterworth), spikes alone (finder
-/// alone: default, sessions 9-21; finder + model: default, sessions 9-21),
+/// alone: default, own-jump; finder + model: default, own-jump),
 /// the oracle on spikes on random noise, the median of 3 frames on spikes
 /// alone.
 const COLUMNS: usize = 10;
@@ -47,11 +47,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         takes.len()
     );
     println!(
-        "| seed | spikes: default finder + model | sessions 9-21 finder + model | Butterworth 2 Hz | \
-         cross-validated Butterworth | ratio (default, sessions 9-21) | spikes alone: default finder | \
-         sessions 9-21 finder | default finder + model | sessions 9-21 finder + model | oracle: true spikes \
+        "| seed | spikes: default finder + model | own-jump finder + model | Butterworth 2 Hz | \
+         cross-validated Butterworth | ratio (default, own-jump) | spikes alone: default finder | \
+         own-jump finder | default finder + model | own-jump finder + model | oracle: true spikes \
          bridged, then the model | ratio (oracle) | spikes alone: median of 3 | ratio to it (default finder, \
-         sessions 9-21) |"
+         own-jump) |"
     );
     println!(
         "| ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"

@@ -6,7 +6,7 @@
 //! each spiked subtree is either
 //!
 //! - bridged (slerp from the frame before the spike to the frame after it,
-//!   what `mocap clean --despike` does with the spikes it finds), then the
+//!   what `mocap clean apply --despike` does with the spikes it finds), then the
 //!   learned Wiener filter runs; or
 //! - bridged, then marked missing for the Wiener filter, which estimates it
 //!   from the rest of the body in every segment the spike touches
@@ -21,11 +21,11 @@
 //! filter) in place of the filter: reading the spikes, after bridging the
 //! true ones, and on the takes without spikes.
 //!
-//! Last, not an oracle: spike finding as sessions 4-8 ran it (on local
-//! rotations, in the shipped model's output) bridged in that output, or in
-//! the input before the model runs again; and as `mocap clean --despike`
-//! runs it now (on global rotations, in the input, before the model, or
-//! before the Butterworth filter).
+//! Last, not an oracle: spike finding on local rotations in the shipped
+//! model's output, bridged in that output, or in the input before the model
+//! runs again; and as `mocap clean apply --despike` runs it (on global
+//! rotations, in the input, before the model, or before the Butterworth
+//! filter).
 //!
 //! Against: the noisy input, the best fixed Butterworth on the evaluation's
 //! spike condition (2nd order, 2 Hz), the Wiener filter reading the spikes
@@ -33,18 +33,16 @@
 //! perfect spike removal would give). Mean rotation error over all joints
 //! and frames (degrees).
 //!
-//! cargo run --profile test -p mocap-clean --example spike_oracle -- DATA [TAKES] [SIGMAS] [WIENER_FILE]
+//! cargo run --release -p mocap-studies --example clean_spike_oracle -- DATA [TAKES] [SIGMAS] [WIENER_FILE]
 
-mod support;
+use mocap_studies::clean as support;
 
 use std::time::Instant;
 
-use mocap_clean::despike::{bridge_spikes, remove_spikes, DespikeOptions, FoundSpike};
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::features::{FeatureLayout, Representation};
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::CleanModel;
-use mocap_clean::wiener::WienerFilter;
+use mocap_clean::{
+    bridge_spikes, filter_motion, remove_spikes, rotation_error_deg, CleanModel, DespikeOptions,
+    FeatureLayout, Filter, FoundSpike, Representation, WienerFilter,
+};
 use mocap_core::Motion;
 use rayon::prelude::*;
 
@@ -143,7 +141,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .map(|((&a, &b), &gone)| if gone { b } else { a })
                     .collect();
                 // Not an oracle: spike finding on the model's output
-                // (`mocap clean --despike`), its spikes bridged in that
+                // (local rotations), its spikes bridged in that
                 // output, or in the input before cleaning it again.
                 let on_output = DespikeOptions {
                     threshold: 3.0,

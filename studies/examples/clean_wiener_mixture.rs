@@ -1,5 +1,5 @@
 //! Study: one multichannel Wiener filter for every kind of motion against a
-//! mixture (`mocap_clean::wiener::fit_mixture`: spectra per content named in
+//! mixture (`mocap_clean::fit_mixture`: spectra per content named in
 //! the file names, contents with fewer than `MIN_SEGMENTS` training segments
 //! together, and the single filter's spectra as a last component; the same
 //! noise covariance), the component chosen per take by the marginal
@@ -7,16 +7,16 @@
 //! rotation error (degrees), and how often the component of the take's own
 //! content was chosen.
 //!
-//! cargo run --profile test -p mocap-clean --example wiener_mixture -- DATA [TAKES] [SIGMAS] [MIN_SEGMENTS]
+//! cargo run --release -p mocap-studies --example clean_wiener_mixture -- DATA [TAKES] [SIGMAS] [MIN_SEGMENTS]
 
-mod support;
+use mocap_studies::clean as support;
 
 use std::collections::BTreeMap;
 
-use mocap_clean::dataset::{list_bvh, load_takes, paths_in_split, Split, SplitFractions};
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::noise::{add_random_noise_sigma, RandomNoise};
-use mocap_clean::wiener::{fit_mixture, WienerFilter};
+use mocap_clean::{
+    add_random_noise_sigma, fit_mixture, list_bvh, load_takes, paths_in_split, rotation_error_deg,
+    RandomNoise, Split, SplitFractions, WienerFilter,
+};
 use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;

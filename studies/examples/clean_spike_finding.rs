@@ -3,30 +3,28 @@
 //!
 //! On validation takes with random noise (sigma drawn in 0-10 degrees) and
 //! 1-3 spikes, seeded as `spike_oracle` seeds its last row, spikes are looked
-//! for either in the shipped model's output (as sessions 4-8 did) or in the
-//! noisy input (as `mocap clean --despike` does now), on local or global
+//! for either in the shipped model's output (local rotations, span 3) or in
+//! the noisy input (as `mocap clean apply --despike` does), on local or global
 //! rotations ([`DespikeOptions::global`]), with a grid of spans and
 //! thresholds (and of the longest spike looked for, on global rotations in
 //! the input); they are bridged in the input and the model runs on it. Printed: the mean
 //! rotation error of each setting, two oracles (the true spikes bridged; the
 //! model at the noise level estimated without spikes), the best fixed filter
-//! of the evaluation's spike condition (Butterworth, 2 Hz), and, for the old and
-//! the new default, every true spike sorted into found / found on a joint
+//! of the evaluation's spike condition (Butterworth, 2 Hz), and, for finding
+//! in the model's output and the default, every true spike sorted into found / found on a joint
 //! above or below / missed (by why), weighted by the error it adds to the
 //! input. `SPIKE_DETAILS=1` lists the missed spikes with their jumps.
 //!
-//! cargo run --profile test -p mocap-clean --example spike_finding -- DATA [TAKES]
+//! cargo run --release -p mocap-studies --example clean_spike_finding -- DATA [TAKES]
 
-mod support;
+use mocap_studies::clean as support;
 
 use std::time::Instant;
 
-use mocap_clean::despike::{
-    bridge_spikes, find_spikes, normalised_jumps, DespikeOptions, FoundSpike,
+use mocap_clean::{
+    bridge_spikes, filter_motion, find_spikes, normalised_jumps, rotation_error_deg, CleanModel,
+    DespikeOptions, Filter, FoundSpike,
 };
-use mocap_clean::eval::rotation_error_deg;
-use mocap_clean::filters::{filter_motion, Filter};
-use mocap_clean::infer::CleanModel;
 use mocap_core::rotation::angle_between;
 use mocap_core::Motion;
 use rayon::prelude::*;
@@ -53,8 +51,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = CleanModel::load_default(Default::default())?;
     let takes = args.validation_takes()?;
     // (label, where spikes are looked for: 0 the model's output, 1 the
-    // noisy input; options). Spikes up to 90 frames long (sessions 4-8's
-    // longest), then the longest spike varied.
+    // noisy input; options). Spikes up to 90 frames long, then the longest
+    // spike varied.
     let mut settings: Vec<(String, usize, Option<DespikeOptions>)> =
         vec![("no spike finding".to_string(), 0, None)];
     for (signal, place) in [(0, "model output"), (1, "input")] {
@@ -97,11 +95,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ));
         }
     }
-    // The spikes of these two are sorted: sessions 4-8's setting and the
-    // default.
+    // The spikes of these two are sorted: finding in the model's output and
+    // the default.
     let sorted = [
         (
-            "model output, local rotations, span 3, threshold 3 (sessions 4-8)",
+            "model output, local rotations, span 3, threshold 3",
             0,
             DespikeOptions {
                 span: 3,

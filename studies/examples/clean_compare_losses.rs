@@ -2,14 +2,14 @@
 //! with the derivative loss, validation curves overlaid in one PNG, and the
 //! area under the first epochs' validation curve.
 //!
-//! cargo run --release -p mocap-clean --example compare_losses -- \
+//! cargo run --release -p mocap-studies --example clean_compare_losses -- \
 //!     --data ../shared/data/bandai --out-dir bench/clean/compare \
 //!     [--seeds 1,2,3] [--epochs 8] [--steps 20] [--batch 512] [--auc-epochs 3] [--max-train-takes N]
 //!     [--replot]   (only redraw validation_curves.png from summary.json)
 
 use std::path::PathBuf;
 
-use mocap_clean::training::{train, TrainOptions};
+use mocap_clean::{train, TrainOptions};
 use mocap_nn::plot::{plot_curves, PlotOptions, Series};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
