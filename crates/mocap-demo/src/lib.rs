@@ -314,7 +314,7 @@ macro_rules! stage_error_from {
 }
 stage_error_from!(
     mocap_core::Error,
-    mocap_clean::CleanError,
+    // CleanError and StyleError are both this one type.
     mocap_nn::CapabilityError,
     mocap_search::SearchError,
     std::io::Error

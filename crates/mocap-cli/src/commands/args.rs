@@ -33,7 +33,9 @@ pub struct ReportArgs {
     pub markdown: Option<PathBuf>,
 }
 
-/// The training loop of every network (`mocap clean train`, `mocap style train`).
+/// The training loop of every network (`mocap clean train`, `mocap style train`;
+/// flatten [`DeviceArgs`] beside it: clap keeps no options in a group that
+/// flattens another).
 #[derive(clap::Args, Clone, Debug)]
 pub struct TrainLoopArgs {
     /// Training epochs (default: the recipe's).
@@ -58,8 +60,6 @@ pub struct TrainLoopArgs {
     /// Training and validation curves as PNG (default: OUTPUT with extension png).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<PathBuf>,
-    #[command(flatten)]
-    pub device: DeviceArgs,
 }
 
 /// Overrides a default when the option was given.

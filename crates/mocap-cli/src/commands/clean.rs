@@ -88,6 +88,8 @@ struct CleanTrainArgs {
     output: PathBuf,
     #[command(flatten)]
     train_loop: TrainLoopArgs,
+    #[command(flatten)]
+    device: DeviceArgs,
     /// The network's shape and the synthetic spikes' settings as TOML (keys: large, width, levels,
     /// blocks, window, spike_probability, max_spikes, spike_sigma; each optional). The shipped
     /// network's: crates/mocap-clean/recipes/shipped-network.toml.
@@ -315,7 +317,7 @@ fn run_train(a: CleanTrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         state_dir: a.state,
         resume: l.resume,
         plot: l.plot,
-        device: l.device.device,
+        device: a.device.device,
         seed: l.seed,
         max_train_takes: a.max_train_takes,
         derivative_loss: a.loss == "derivative",

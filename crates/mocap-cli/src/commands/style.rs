@@ -42,6 +42,8 @@ struct TrainArgs {
     output: PathBuf,
     #[command(flatten)]
     training: TrainLoopArgs,
+    #[command(flatten)]
+    device: DeviceArgs,
     /// Train on these contents only (comma separated; default: every clip in the folders; the
     /// shipped model: walk,walk-back,walk-left,walk-right,walk-turn-left,walk-turn-right).
     #[arg(long, value_delimiter = ',')]
@@ -201,7 +203,7 @@ fn train_options(a: TrainArgs) -> TrainOptions {
         held_out_take: a.held_out,
         mirror: !a.no_mirror,
         seed: a.training.seed,
-        device: a.training.device.device,
+        device: a.device.device,
         plot: a.training.plot,
         resume: a.training.resume,
         foot_loss_weight: a.foot_loss,
