@@ -16,10 +16,10 @@ OUT=bench/clean/model
 mkdir -p "$OUT"
 # The learned multichannel Wiener filter: spectra of the 929 training takes, 32-frame segments (about 70 s).
 $MOCAP clean fit-wiener "$DATA" -o models/clean-wiener.safetensors
-# The network reading and correcting it: width 64, 32-frame windows (bench/clean/network.toml), the filter run on
+# The network reading and correcting it: width 64, 32-frame windows (models/clean-recipe.toml), the filter run on
 # 128 frames each side of a window, its output and noise level as inputs, 12 epochs x 40 steps x 256 windows,
 # derivative loss, lr 1e-3, seed 1 (45 min).
-$MOCAP clean train "$DATA" --recipe bench/clean/network.toml \
+$MOCAP clean train "$DATA" --recipe models/clean-recipe.toml \
     --base-wiener models/clean-wiener.safetensors --base-context 128 --base-input \
     --epochs 12 --steps 40 --batch 256 --lr 1e-3 --seed 1 --plot "$OUT/network.png" -o "$OUT/network.safetensors"
 # That network, not retrained, on a mixture of its own filter: one set of spectra per content with at least 150

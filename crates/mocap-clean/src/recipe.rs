@@ -5,7 +5,7 @@
 //! refused, naming the file and the key.
 //!
 //! ```toml
-//! # The shipped network's shape (crates/mocap-clean/recipes/shipped-network.toml).
+//! # The shipped network's shape (models/clean-recipe.toml).
 //! width = 64
 //! window = 32
 //! ```
@@ -111,7 +111,7 @@ mod tests {
 
     #[test]
     fn the_shipped_network_recipe_reads() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("recipes/shipped-network.toml");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/clean-recipe.toml");
         let recipe = TrainRecipe::load(&path).unwrap();
         assert_eq!((recipe.width, recipe.window), (Some(64), Some(32)));
     }

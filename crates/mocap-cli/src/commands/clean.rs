@@ -92,7 +92,7 @@ struct CleanTrainArgs {
     device: DeviceArgs,
     /// The network's shape and the synthetic spikes' settings as TOML (keys: large, width, levels,
     /// blocks, window, spike_probability, max_spikes, spike_sigma; each optional). The shipped
-    /// network's: crates/mocap-clean/recipes/shipped-network.toml.
+    /// network's: models/clean-recipe.toml.
     #[arg(long, value_name = "FILE.toml")]
     recipe: Option<PathBuf>,
     /// `derivative` (rotation + velocity + acceleration terms, alpha = dt^2, beta = dt^4) or `mse`.
@@ -362,7 +362,7 @@ fn run_train(a: CleanTrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
                  behind `--filter butterworth-gcv:2` (bench/results/clean.md). The shipped model \
                  corrects a Wiener filter: `mocap clean fit-wiener DIR -o wiener.safetensors`, \
                  then `--base-wiener wiener.safetensors --base-context 128 --base-input \
-                 --recipe crates/mocap-clean/recipes/shipped-network.toml` \
+                 --recipe models/clean-recipe.toml` \
                  (docs/clean-guide.md, \"Training your own Wiener filter or model\")"
             );
         }
