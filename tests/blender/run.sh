@@ -41,7 +41,7 @@ if [ -f "$DATA/hdm05-sample/HDM_bd.asf" ]; then
 else
     echo "note: $DATA/hdm05-sample is absent; the ASF/AMC conversion is not checked"
 fi
-"$MOCAP" demo --quiet --no-pictures --out "$OUT/demo" > /dev/null
+"$MOCAP" demo --quiet --no-pictures -o "$OUT/demo" > /dev/null
 for f in fuse/fused.bvh fuse/truth.bvh clean/noisy.bvh clean/cleaned.bvh style/restyled.bvh; do
     if [ -f "$OUT/demo/$f" ]; then
         files+=("$OUT/demo/$f")

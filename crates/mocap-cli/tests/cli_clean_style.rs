@@ -372,7 +372,7 @@ fn clean_fit_wiener_fits_a_filter_that_apply_and_eval_use() {
     assert_eq!(report["description"]["segment"], 32);
     assert!(filter.is_file());
 
-    // `mocap clean --model` tells the filter from a network by its header.
+    // `mocap clean apply --model` tells the filter from a network by its header.
     let out = clean_walk_with(&filter, dir.path());
     assert!(out.status.success(), "{}", stderr(&out));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
