@@ -10,14 +10,13 @@
 //! The validation loss is the plain mean squared error of the features, for
 //! every training loss, so that curves of different losses compare.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use burn::module::Module;
-use burn::optim::AdamConfig;
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{save_epoch, CheckpointHeader, TrainingState};
+use mocap_nn::checkpoint::{save_epoch, start_run, CheckpointHeader, RunStart};
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
 use mocap_nn::train::{epoch_seed, optimizer_step, run_epochs, EpochPlan, History};
@@ -390,10 +389,6 @@ fn validation_loss(
     sum / batches.len().max(1) as f64
 }
 
-fn with_extension(path: &Path, extension: &str) -> PathBuf {
-    path.with_extension(extension)
-}
-
 /// Trains a denoiser (see the module docs).
 pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let started = Instant::now();
@@ -549,21 +544,20 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let device = options.device.training_device()?;
     let plain_device = options.device.device()?;
     seed_device(&device, options.seed);
-    let state_dir = options
-        .state_dir
-        .clone()
-        .unwrap_or_else(|| with_extension(&options.out, "state"));
-    let state = TrainingState::new(&state_dir);
-    let (model, optimizer, mut history) = state.resume_or_start(
+    let RunStart {
+        state,
+        plot,
+        model,
+        optimizer,
+        mut history,
+    } = start_run(
+        &options.out,
+        options.state_dir.as_deref(),
+        options.plot.as_deref(),
         options.resume,
         network.init(&device)?,
-        AdamConfig::new().init(),
     )?;
     let resumed_from_epoch = history.epochs.len();
-    let plot = options
-        .plot
-        .clone()
-        .unwrap_or_else(|| with_extension(&options.out, "png"));
     let header = |history: &History| CheckpointHeader {
         kind: CHECKPOINT_KIND.into(),
         kind_version: CHECKPOINT_KIND_VERSION,
@@ -698,6 +692,7 @@ mod tests {
     use crate::filters::filter_features;
     use crate::test_support::synthetic_motion_phase;
     use mocap_core::io::bvh::write_bvh;
+    use std::path::Path;
 
     /// Training seeds the device's global generator: runs in parallel tests
     /// would draw from it in turn and lose their reproducibility.

@@ -299,6 +299,47 @@ impl TrainingState {
     }
 }
 
+/// What a training run starts from, and where it writes besides its model
+/// file: see [`start_run`].
+pub struct RunStart<M> {
+    /// The resumable state: `state_dir` when given, else the model file's
+    /// name with extension `state`.
+    pub state: TrainingState,
+    /// The picture of the curves: `plot` when given, else the model file's
+    /// name with extension `png`.
+    pub plot: PathBuf,
+    /// The network, Adam and the epochs run so far: the saved ones when
+    /// resuming from a complete state, else the fresh network, a new Adam
+    /// and no epochs.
+    pub model: M,
+    pub optimizer: ModuleOptimizer,
+    pub history: crate::train::History,
+}
+
+/// Starts (or resumes) the training run of every learned capability, which
+/// writes `model_file`.
+pub fn start_run<M: Module>(
+    model_file: &Path,
+    state_dir: Option<&Path>,
+    plot: Option<&Path>,
+    resume: bool,
+    fresh: M,
+) -> Result<RunStart<M>> {
+    let state = TrainingState::new(
+        state_dir.map_or_else(|| model_file.with_extension("state"), Path::to_path_buf),
+    );
+    let plot = plot.map_or_else(|| model_file.with_extension("png"), Path::to_path_buf);
+    let (model, optimizer, history) =
+        state.resume_or_start(resume, fresh, burn::optim::AdamConfig::new().init())?;
+    Ok(RunStart {
+        state,
+        plot,
+        model,
+        optimizer,
+        history,
+    })
+}
+
 /// What a resumable training state records besides the weights and the
 /// optimizer: the history of the epochs run so far.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -19,13 +19,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use burn::module::Module;
-use burn::optim::AdamConfig;
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::ops::resample_fps;
 use mocap_core::rotation::Quat;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_epoch, CheckpointHeader, TrainingState,
+    header_from_bytes, load_weights_from_bytes, save_epoch, start_run, CheckpointHeader, RunStart,
 };
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
@@ -477,22 +476,20 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     let device = options.device.training_device()?;
     let plain_device = options.device.device()?;
     seed_device(&device, options.seed);
-    let state = TrainingState::new(
-        options
-            .state_dir
-            .clone()
-            .unwrap_or_else(|| options.out.with_extension("state")),
-    );
-    let (model, optimizer, mut history) = state.resume_or_start(
+    let RunStart {
+        state,
+        plot,
+        model,
+        optimizer,
+        mut history,
+    } = start_run(
+        &options.out,
+        options.state_dir.as_deref(),
+        options.plot.as_deref(),
         options.resume,
         network.init(&device)?,
-        AdamConfig::new().init(),
     )?;
     let resumed_from_epoch = history.epochs.len();
-    let plot = options
-        .plot
-        .clone()
-        .unwrap_or_else(|| options.out.with_extension("png"));
     let header = |history: &History| CheckpointHeader {
         kind: CHECKPOINT_KIND.into(),
         kind_version: CHECKPOINT_KIND_VERSION,
