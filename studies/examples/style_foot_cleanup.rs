@@ -1,6 +1,6 @@
 //! The foot-contact cleanup (`--foot-contacts`) measured on the evaluation's
 //! held-out pairs, with contacts found by height alone and with the current
-//! settings (bench/results/style.md, "Foot-contact cleanup").
+//! settings (bench/results/style.md, "The root and the feet").
 //!
 //! ```text
 //! cargo run --release -p mocap-studies --example style_foot_cleanup -- DIR... [--held-out last|first] [--model M]

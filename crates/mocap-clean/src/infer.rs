@@ -209,7 +209,7 @@ pub enum Method {
     Filter(Filter),
     /// No denoising: only the spike finding asked for (takes with little
     /// random noise, which the shipped model would make worse; see
-    /// bench/results/clean.md, "Spikes alone").
+    /// bench/results/clean.md, "Against the targets").
     SpikesOnly,
 }
 

@@ -310,7 +310,7 @@ impl CleanModel {
                  has {} ({c} features against {}): clean it with --filter butterworth-gcv:2, or \
                  train a model on this rig with `mocap clean train` (played by the model's rig \
                  through retargeting, takes of other rigs came out worse than with that filter: \
-                 bench/results/clean.md, \"Takes of other rigs\")",
+                 bench/results/clean.md, \"Known limits\")",
                 self.description.joints.len(),
                 self.description.joints[..self.description.joints.len().min(3)].join(", "),
                 layout.joints.len(),

@@ -124,8 +124,8 @@ const CHOICE_SEGMENTS: usize = 8;
 /// passes what the clean spectra hold, and at 0.05 degrees it still damps
 /// the frequencies where they hold almost nothing (the model moved clean
 /// test takes by 0.062 degrees on average with the grid starting at 0.05,
-/// 0.043 with these; `bench/results/clean.md`, "A noise level robust to
-/// spikes").
+/// 0.043 with these; `docs/research/clean.md`, "The noise level the
+/// network reads").
 fn sigma_grid_deg() -> impl Iterator<Item = f64> {
     [0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.03, 0.04]
         .into_iter()
@@ -376,8 +376,8 @@ pub enum LevelEstimate {
     /// the finder missed, the remains of a bridged one, a burst of motion
     /// faster than the training spectra) then do not raise the level of
     /// the whole take, where the random noise of a capture is the same
-    /// throughout. See "A noise level robust to spikes" in
-    /// `bench/results/clean.md`.
+    /// throughout. See "The noise level the network reads" in
+    /// `docs/research/clean.md`.
     #[default]
     SegmentMedian,
     /// The level of largest likelihood (2) over all segments together: the

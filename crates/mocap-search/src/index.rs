@@ -109,7 +109,7 @@ pub enum Ranking {
     /// One minus the forest proximity along the trees' paths
     /// ([`Forest::path_proximity`]). For clips of classes the forest was not
     /// trained on the histogram distance measured better
-    /// (bench/results/search.md, "Unseen classes").
+    /// (bench/results/search.md, "Ranking", unseen classes).
     Proximity,
     /// Euclidean distance between the standardised resampled features.
     Features,

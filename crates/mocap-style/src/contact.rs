@@ -67,7 +67,7 @@ pub struct ContactOptions {
 
 impl Default for ContactOptions {
     /// Chosen on the evaluation's held-out pairs (the study
-    /// `style_foot_cleanup`, bench/results/style.md, "Foot-contact cleanup"),
+    /// `style_foot_cleanup`, bench/results/style.md, "The root and the feet"),
     /// without the style judges: the reach limit, 1.02, among 0.99, 1,
     /// 1.02, 1.05 and 1.1 as the least flat-foot sliding before more
     /// outputs put a foot out further than any real clip; the height

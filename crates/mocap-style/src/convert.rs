@@ -18,7 +18,7 @@
 //!    frames comes out 48 frames long, at the style's pace. Fixed patches
 //!    always take `L = P`. (The report does not give `P`; 48 was chosen on
 //!    one fold of the Bandai takes and judged on the other:
-//!    bench/results/style.md, "The patch length, again".)
+//!    docs/research/style.md, "Patches and timing".)
 //! 3. Seams: a second series of patches, offset by half a patch (each from
 //!    the centre of one stretched patch to the centre of the next), is
 //!    matched too, and the two are blended with linear weights along time

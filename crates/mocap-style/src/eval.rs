@@ -139,7 +139,7 @@ impl std::str::FromStr for StyleJudge {
 
 impl EvalOptions {
     /// Judges style with `judge` in the setting measured for it on real
-    /// clips (bench/results/style.md, "A second judge: a small conv net").
+    /// clips (bench/results/style.md, "Three judges, three seeds").
     pub fn set_style_judge(&mut self, judge: StyleJudge) {
         match judge {
             StyleJudge::Forest => {

@@ -3,7 +3,7 @@
 //!
 //! Decoded from its own latent codes, a walk's flat feet slide about 24 cm/s
 //! where the real take's stand still (4-7.5 cm/s; bench/results/style.md,
-//! "How much the feet slide"): each leg rotation comes back a few degrees
+//! "The root and the feet"): each leg rotation comes back a few degrees
 //! off, and the error changes from frame to frame. The reconstruction loss
 //! weighs every channel alike and does not see that a degree at the hip is
 //! 1.5 cm at the ankle. This term does: for the ankles and toes, their

@@ -145,7 +145,7 @@ fn restyled_walk_keeps_the_source_rig_and_takes_the_style_timing() {
 /// makes the feet slide several times more). This is the coarse measure: a
 /// flat foot on the ground does slide several times more than the source's
 /// ([`planted_foot_sliding`]), half of it from the autoencoder alone
-/// (bench/results/style.md, "How much the feet slide").
+/// (bench/results/style.md, "The root and the feet").
 #[test]
 fn same_style_transfer_keeps_the_feet_planted() {
     let Some(Pair {
@@ -437,7 +437,7 @@ fn restyled_with(
 /// Restyled turns keep their turn. In a right turn the feet land to one
 /// side of the pelvis (in the body's own frame), where a straight walk's
 /// are about centred; the style's symmetric statistics and a straight
-/// walk's patches centred them (bench/results/style.md, "Turns kept").
+/// walk's patches centred them (bench/results/style.md, "Turns kept along the take").
 /// Keeping the source's left-right asymmetry (the default) brings the
 /// output's mean sideways foot offset back towards the source's. Six
 /// held-out right turns of six styles, restyled with a held-out straight
@@ -568,7 +568,7 @@ fn a_take_that_walks_then_turns_keeps_each_parts_footwork() {
 }
 
 /// The shipped model was trained with the loss on the planted feet
-/// (`--foot-loss 300`, bench/results/style.md, "A loss on the feet"): a
+/// (`--foot-loss 300`, bench/results/style.md, "The shipped model"): a
 /// held-out walk decoded from its own latent codes (strength 0, no style)
 /// keeps a flat foot nearly as still as the take does. The seven held-out
 /// dataset-2 straight walks: 10.1 cm/s of flat-foot sliding against the

@@ -53,7 +53,7 @@ struct TrainArgs {
     window: Option<usize>,
     /// Weight of a loss on the feet added to the reconstruction error: flat feet of the clips
     /// stay still in the reconstruction (0: the report's loss; measured with 300 in
-    /// bench/results/style.md, "A loss on the feet").
+    /// bench/results/style.md, "The shipped model").
     #[arg(long, default_value_t = 0.0, value_name = "W")]
     foot_loss: f64,
     /// Do not add mirrored copies of the clips.
