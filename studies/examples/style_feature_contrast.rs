@@ -1,7 +1,7 @@
 //! Which of mocap-search's per-frame pose values tell two contents apart, and
 //! where some other clips (restyled outputs, say) sit between them: used to
 //! see why restyled turns are read as straight walks (bench/results/style.md,
-//! "The other fold").
+//! "Both folds").
 //!
 //! ```text
 //! cargo run --release -p mocap-studies --example style_feature_contrast -- \

@@ -74,8 +74,8 @@ pub struct DespikeOptions {
     /// the pelvis and the spine of a body) by its subtree's jump alone, not
     /// also by its own. A spike there swaps several limbs, which jump, but
     /// the trunk joint itself often turns little: both the take and the
-    /// motion it was swapped with stand upright (bench/results/clean.md,
-    /// "Spikes of the trunk"). On by default; settings written without it
+    /// motion it was swapped with stand upright (docs/research/clean.md,
+    /// "Finding spikes"). On by default; settings written without it
     /// read it as off, which is how they ran.
     #[serde(default)]
     pub trunk_by_subtree: bool,
