@@ -138,6 +138,50 @@ fn a_failed_convert_leaves_no_output_file() {
     );
 }
 
+/// Options whose values would write a file no reader takes (`--scale NaN`),
+/// or allocate without bound (`--fps 1e9`: a billion frames a second), are
+/// refused before any output, with exit code 1 and no file left.
+#[test]
+fn convert_refuses_options_that_would_write_an_absurd_or_unreadable_take() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("out.bvh");
+    for (option, value, phrase) in [
+        ("--fps", "1e9", "the rate must be 0.1 to 1000000"),
+        (
+            "--fps",
+            "999999",
+            "more than the 268435456 values a motion may hold",
+        ),
+        ("--scale", "NaN", "the factor must be a positive number"),
+        ("--scale", "0", "the factor must be a positive number"),
+        ("--scale", "1e37", "is not a finite number"),
+    ] {
+        let out = mocap(&[
+            "convert",
+            &sample(),
+            option,
+            value,
+            out_path.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{option} {value}: {}",
+            stderr(&out)
+        );
+        assert!(
+            stderr(&out).contains(phrase),
+            "{option} {value}: {}",
+            stderr(&out)
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "{option} {value}: a file was left"
+        );
+    }
+}
+
 #[test]
 fn asf_amc_converts_to_a_bvh_with_the_same_poses() {
     let Some(data) = shared_data() else { return };

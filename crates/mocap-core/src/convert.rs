@@ -51,6 +51,11 @@ pub fn convert_files(inputs: &[PathBuf], options: &ConvertOptions) -> Result<Mot
             .map_err(|e| Error::Invalid(format!("mirroring {first}: {e}")))?;
     }
     if let Some(factor) = options.scale {
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(Error::Invalid(format!(
+                "cannot scale by {factor}: the factor must be a positive number"
+            )));
+        }
         motion = ops::scale(&motion, factor);
     }
     if let Some(rig) = &options.retarget_to {

@@ -28,5 +28,5 @@ pub mod skeleton;
 
 pub use error::{Error, ParseError, Result};
 pub use kinematics::{forward_kinematics, GlobalPoses};
-pub use motion::Motion;
+pub use motion::{Motion, FRAME_TIME_RANGE, MAX_VALUES};
 pub use skeleton::{Channel, Joint, Skeleton};

@@ -9,6 +9,18 @@ use crate::error::{Error, Result};
 use crate::rotation::{quat_to_euler_near, Axis, EulerOrder, Quat, Vec3};
 use crate::skeleton::{Channel, Joint, Skeleton};
 
+/// The frame times a motion may have, in seconds: a million frames per
+/// second to one frame every ten seconds. Outside it a take is a broken file
+/// (`Frame Time: 1e300` makes every duration infinite, `1e-300` every speed),
+/// not a capture.
+pub const FRAME_TIME_RANGE: std::ops::RangeInclusive<f64> = 1e-6..=10.0;
+
+/// The most channel values one motion may hold (frames × channels): 2^28, a
+/// gigabyte of `f32`, above the largest real takes (a 1 GB BVH file holds
+/// about 113 million). An edit whose output would be larger (resampling a
+/// take to a billion frames per second) is refused before it allocates.
+pub const MAX_VALUES: usize = 1 << 28;
+
 const DEG: f32 = std::f32::consts::PI / 180.0;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -22,16 +34,18 @@ pub struct Motion {
 
 impl Motion {
     /// A motion from channel values laid out frame after frame. The frame
-    /// time is in seconds and must be positive.
+    /// time is in seconds, within [`FRAME_TIME_RANGE`].
     pub fn new(
         skeleton: Skeleton,
         frame_time: f64,
         frame_count: usize,
         values: Vec<f32>,
     ) -> Result<Motion> {
-        if !(frame_time.is_finite() && frame_time > 0.0) {
+        if !FRAME_TIME_RANGE.contains(&frame_time) {
             return Err(Error::Invalid(format!(
-                "frame time must be a positive number of seconds, got {frame_time}"
+                "frame time must be {} to {} seconds, got {frame_time}",
+                FRAME_TIME_RANGE.start(),
+                FRAME_TIME_RANGE.end()
             )));
         }
         let expected = frame_count * skeleton.channel_count();

@@ -11,7 +11,7 @@ use std::ops::Range;
 use crate::bodymap::{BodyMap, BodyPart};
 use crate::error::{Error, Result};
 use crate::kinematics::forward_kinematics;
-use crate::motion::Motion;
+use crate::motion::{Motion, FRAME_TIME_RANGE, MAX_VALUES};
 use crate::rotation::{angle_between, slerp, Axis, Mat3, Quat, Vec3};
 use crate::skeleton::{Joint, Skeleton};
 
@@ -89,8 +89,20 @@ pub fn resample_fps(motion: &Motion, fps: f64) -> Result<Motion> {
     }
     let n = source_frames(motion)?;
     let frame_time = 1.0 / fps;
+    if !FRAME_TIME_RANGE.contains(&frame_time) {
+        return Err(Error::Invalid(format!(
+            "cannot resample to {fps} frames per second: the rate must be {} to {}",
+            1.0 / FRAME_TIME_RANGE.end(),
+            (1.0 / FRAME_TIME_RANGE.start()).round()
+        )));
+    }
     let span_in_new_frames = (n - 1) as f64 * motion.frame_time() * fps;
     let count = (span_in_new_frames + ON_FRAME).floor() as usize + 1;
+    check_size(
+        motion,
+        count,
+        &format!("resampling to {fps} frames per second"),
+    )?;
     let step = frame_time / motion.frame_time();
     resample_at(motion, count, frame_time, |k| k as f64 * step)
 }
@@ -113,11 +125,29 @@ pub fn resample_frames(motion: &Motion, frame_count: usize) -> Result<Motion> {
             "cannot resample a one-frame motion to {frame_count} frames: it spans no time"
         )));
     }
+    check_size(
+        motion,
+        frame_count,
+        &format!("resampling to {frame_count} frames"),
+    )?;
     let span = (n - 1) as f64;
     let frame_time = motion.frame_time() * span / (frame_count - 1) as f64;
     resample_at(motion, frame_count, frame_time, |k| {
         k as f64 * span / (frame_count - 1) as f64
     })
+}
+
+/// Refuses an edit that would give `motion` `frames` frames holding more
+/// than [`MAX_VALUES`] channel values, before anything is allocated.
+fn check_size(motion: &Motion, frames: usize, edit: &str) -> Result<()> {
+    let channels = motion.skeleton().channel_count();
+    if frames.saturating_mul(channels) > MAX_VALUES {
+        return Err(Error::Invalid(format!(
+            "{edit} would make {frames} frames of {channels} channels, more than the \
+             {MAX_VALUES} values a motion may hold"
+        )));
+    }
+    Ok(())
 }
 
 fn source_frames(motion: &Motion) -> Result<usize> {

@@ -251,8 +251,23 @@ fn bad_frame_count_or_frame_time() {
         &with_line(18, Some("Frame Time: 0")),
         18,
         13,
-        "positive frame time",
+        "a frame time of 0.000001 to 10 seconds",
     );
+    // Frame times no capture has: every duration infinite, every speed NaN.
+    for absurd in ["1e300", "1e-300", "11", "0.0000009"] {
+        assert_error(
+            &with_line(18, Some(&format!("Frame Time: {absurd}"))),
+            18,
+            13,
+            &format!(
+                "a frame time of 0.000001 to 10 seconds after `Frame Time:`, found \"{absurd}\""
+            ),
+        );
+    }
+    for sane in ["0.000001", "10", "0.008333"] {
+        let text = with_line(18, Some(&format!("Frame Time: {sane}")));
+        read_bvh_from(Cursor::new(text.as_bytes()), Path::new("take.bvh")).unwrap();
+    }
     assert_error(
         &with_line(18, Some("Frame Time: 0.03 0.04")),
         18,

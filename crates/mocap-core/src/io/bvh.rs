@@ -90,7 +90,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::io::atomic::write_atomically;
-use crate::motion::Motion;
+use crate::motion::{Motion, FRAME_TIME_RANGE};
 use crate::rotation::Vec3;
 use crate::skeleton::{Channel, Joint, Skeleton};
 
@@ -119,15 +119,17 @@ pub fn write_bvh(path: &Path, motion: &Motion) -> Result<()> {
 
 /// Writes `motion` as BVH text.
 ///
-/// Fails with [`io::ErrorKind::InvalidInput`] when a joint name cannot be
-/// written so that it reads back the same (empty, with a line break or a
-/// `{`, or with spaces at either end).
+/// Fails with [`io::ErrorKind::InvalidInput`], before writing anything, when
+/// the file would not read back the same: a joint name that is empty, has a
+/// line break or a `{`, or spaces at either end; an offset or a channel value
+/// that is not a finite number.
 pub fn write_bvh_to(writer: &mut dyn Write, motion: &Motion) -> io::Result<()> {
     let skeleton = motion.skeleton();
     let joints = skeleton.joints();
     for joint in joints {
         check_writable_name(&joint.name)?;
     }
+    check_finite(motion)?;
 
     // Children of every joint, and the roots, in skeleton order. Parents come
     // before children, so one pass gives every joint's depth too.
@@ -239,6 +241,29 @@ fn check_writable_name(name: &str) -> io::Result<()> {
             io::ErrorKind::InvalidInput,
             format!("joint name {name:?} cannot be written to BVH"),
         ));
+    }
+    Ok(())
+}
+
+/// Every offset and channel value is a finite number: a NaN or an infinity
+/// (from `--scale NaN`, or an overflow) would write a file no reader takes.
+fn check_finite(motion: &Motion) -> io::Result<()> {
+    let refuse = |what: String| {
+        Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("{what} is not a finite number, so the motion cannot be written"),
+        ))
+    };
+    for joint in motion.skeleton().joints() {
+        let offsets = std::iter::once(joint.offset).chain(joint.end_sites.iter().copied());
+        if let Some(bad) = offsets.into_iter().find(|o| !o.is_finite()) {
+            return refuse(format!("an offset of joint {} ({bad})", joint.name));
+        }
+    }
+    let channels = motion.skeleton().channel_count().max(1);
+    if let Some(i) = motion.values().iter().position(|v| !v.is_finite()) {
+        let value = motion.values()[i];
+        return refuse(format!("channel value {value} of frame {}", i / channels));
     }
     Ok(())
 }
@@ -861,10 +886,10 @@ impl<R: BufRead> Parser<R> {
                 })?;
                 frames = Some((count, lines.number));
             } else if let Some(after) = strip_label(&lines.line, start, &["Frame", "Time"]) {
-                let what = "a positive frame time in seconds after `Frame Time:`";
+                let what = "a frame time of 0.000001 to 10 seconds after `Frame Time:`";
                 let (start, word) = single_word(lines, after, what)?;
                 let seconds = parse_f64(word)
-                    .filter(|t| t.is_finite() && *t > 0.0)
+                    .filter(|t| FRAME_TIME_RANGE.contains(t))
                     .ok_or_else(|| {
                         lines
                             .error_here(start + 1, format!("expected {what}, found {}", show(word)))
