@@ -17,13 +17,36 @@ pub struct Location {
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.path.display(), self.line, self.column)
+        let path = self.path.display().to_string();
+        write!(f, "{}:{}:{}", printable(&path), self.line, self.column)
     }
 }
 
+/// `text` with its control characters escaped (`\u{1b}`), line breaks and
+/// tabs kept: messages quote words of the files they are about, and a file
+/// can hold terminal escapes that would retitle or repaint the user's
+/// terminal when the message is printed.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text
+        .chars()
+        .any(|c| c.is_control() && c != '\n' && c != '\t')
+    {
+        return text.into();
+    }
+    text.chars()
+        .map(|c| match c {
+            '\n' | '\t' => c.to_string(),
+            c if c.is_control() => c.escape_default().to_string(),
+            c => c.to_string(),
+        })
+        .collect::<String>()
+        .into()
+}
+
 /// A file that does not follow its format: where, and what was expected.
+/// Printed with its control characters escaped ([`printable`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{location}: {message}")]
+#[error("{location}: {}", printable(message))]
 pub struct ParseError {
     pub location: Location,
     pub message: String,
@@ -55,14 +78,14 @@ pub enum Error {
     Parse(#[from] ParseError),
     // The I/O error is part of the message rather than a `source`, so that
     // printing the error chain does not repeat it.
-    #[error("{path}: {error}")]
+    #[error("{}: {error}", printable(&path.display().to_string()))]
     Io {
         path: PathBuf,
         error: std::io::Error,
     },
     /// A request that does not fit the data (a joint that does not exist, a
     /// frame range outside the take, a body part the rig lacks...).
-    #[error("{0}")]
+    #[error("{}", printable(.0))]
     Invalid(String),
 }
 

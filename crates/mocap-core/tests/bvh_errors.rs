@@ -399,3 +399,16 @@ proptest! {
         let _ = read_bvh_from(Cursor::new(bytes), Path::new("edited.bvh"));
     }
 }
+
+/// A file that starts with a terminal escape (one that retitles the
+/// terminal) gets an error whose text escapes it: printing the error must not
+/// hand the file's control characters to the user's terminal.
+#[test]
+fn control_characters_of_the_file_are_escaped_in_the_message() {
+    let text = "\u{1b}]0;owned\u{7}HIERARCHY\n";
+    let e = parse_error(text);
+    let shown = Error::Parse(e).to_string();
+    assert!(!shown.chars().any(|c| c.is_control()), "{shown:?}");
+    assert!(shown.contains("\\u{1b}]0;owned\\u{7}"), "{shown}");
+    assert!(shown.starts_with("take.bvh:1:1: "), "{shown}");
+}
