@@ -182,6 +182,27 @@ fn convert_refuses_options_that_would_write_an_absurd_or_unreadable_take() {
     }
 }
 
+/// Writing over an input is allowed (a take edited in place) but said, since
+/// a mistyped path loses a take; a new output gets no such note.
+#[test]
+fn convert_says_when_the_output_replaces_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let take = dir.path().join("take.bvh");
+    std::fs::copy(sample(), &take).unwrap();
+    let take = take.to_str().unwrap();
+    let out = mocap(&["convert", take, "--frames", "0..10", take]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("is also an input: the input is replaced"),
+        "{}",
+        stderr(&out)
+    );
+    let other = dir.path().join("other.bvh");
+    let out = mocap(&["convert", take, other.to_str().unwrap()]);
+    assert!(out.status.success());
+    assert!(!stderr(&out).contains("also an input"), "{}", stderr(&out));
+}
+
 #[test]
 fn asf_amc_converts_to_a_bvh_with_the_same_poses() {
     let Some(data) = shared_data() else { return };

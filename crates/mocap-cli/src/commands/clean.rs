@@ -255,6 +255,7 @@ fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         set(&mut d.max_frames, a.despike_max_frames);
         d
     });
+    options.note_if_replacing_an_input(&[&a.input], &a.output);
     let report = clean_file(&CleanOptions {
         input: a.input,
         output: a.output,

@@ -51,6 +51,8 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
         retarget_to: args.retarget_to,
     };
     let motion = convert_files(inputs, &convert)?;
+    let read: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    options.note_if_replacing_an_input(&read, output);
     write_motion(output, &motion)?;
     if !options.quiet {
         eprintln!(

@@ -38,6 +38,26 @@ impl GlobalOptions {
     }
 }
 
+impl GlobalOptions {
+    /// Says so when `output` is one of `inputs`: writing there is allowed (a
+    /// take cleaned in place), but a mistyped path loses a take, so the user
+    /// is told which input the output replaces.
+    pub fn note_if_replacing_an_input(&self, inputs: &[&Path], output: &Path) {
+        let Ok(out) = output.canonicalize() else {
+            return; // the output does not exist yet: it replaces nothing
+        };
+        let replaced = inputs
+            .iter()
+            .any(|input| input.canonicalize().is_ok_and(|i| i == out));
+        if replaced && !self.quiet {
+            eprintln!(
+                "note: the output {} is also an input: the input is replaced",
+                output.display()
+            );
+        }
+    }
+}
+
 /// Writes `text` to `path` atomically, or to standard output for `None` or `-`.
 pub fn write_output(
     path: Option<&Path>,

@@ -286,6 +286,7 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
             }
         }
         StyleCommand::Apply(a) => {
+            options.note_if_replacing_an_input(&[&a.source, &a.style], &a.output);
             let report = apply(&apply_options(&a)?)?;
             if a.json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
