@@ -268,11 +268,15 @@ fn check_finite(motion: &Motion) -> io::Result<()> {
     Ok(())
 }
 
+/// The deepest indentation written, in tabs: deeper than any real rig (a
+/// Mixamo finger tip is about 12 deep), and a cap so that a chain nested
+/// 10,000 deep writes a file that grows with its joints, not their square.
+/// Readers go by the braces, not the tabs.
+const MAX_INDENT: usize = 32;
+
 fn indent(writer: &mut dyn Write, tabs: usize) -> io::Result<()> {
-    for _ in 0..tabs {
-        writer.write_all(b"\t")?;
-    }
-    Ok(())
+    const TABS: [u8; MAX_INDENT] = [b'\t'; MAX_INDENT];
+    writer.write_all(&TABS[..tabs.min(MAX_INDENT)])
 }
 
 fn write_offset(writer: &mut dyn Write, tabs: usize, offset: Vec3) -> io::Result<()> {
