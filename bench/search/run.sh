@@ -27,7 +27,7 @@ run_eval content-dataset-1 bandai-content "$DATA/dataset-1"
 run_eval style-dataset-2 bandai-style "$DATA/dataset-2"
 run_eval style-dataset-1 bandai-style "$DATA/dataset-1"
 
-# Across recording sessions: train on the dataset-2 walks and runs, test on the dataset-1 ones.
+# Across recordings: train on the dataset-2 walks and runs, test on the dataset-1 ones.
 mkdir -p "$TMP/d1-walk-run" "$TMP/d2-walk-run"
 for f in "$DATA"/dataset-1/dataset-1_walk_*.bvh "$DATA"/dataset-1/dataset-1_run_*.bvh; do
     ln -s "$(realpath "$f")" "$TMP/d1-walk-run/"

@@ -137,7 +137,7 @@ impl Motion {
     }
 
     /// Appends the frames of `other`, which must have the same skeleton and
-    /// frame time (for joining takes of one recording session).
+    /// frame time (for joining takes of one recording).
     pub fn append(&mut self, other: &Motion) -> Result<()> {
         if other.skeleton != self.skeleton {
             return Err(Error::Invalid(

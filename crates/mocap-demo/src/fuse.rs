@@ -6,7 +6,7 @@
 //! `sensors` Kinect v2 sensors around the actor (occlusion, depth noise,
 //! left/right swaps when seen from behind, latency, dropped frames). The
 //! person's body (bone lengths, joint ranges) is measured from a second,
-//! independent simulated capture, as a real session measures it beforehand.
+//! independent simulated capture, as a real capture measures it beforehand.
 //! The sensor poses are the simulator's (the demo does not estimate the
 //! calibration; `mocap fuse calibrate` does).
 //!

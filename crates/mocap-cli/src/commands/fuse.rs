@@ -18,7 +18,7 @@ use super::args::ReportArgs;
 use super::GlobalOptions;
 
 #[derive(clap::Args)]
-#[command(after_help = "A session, end to end:\n  \
+#[command(after_help = "A capture, end to end:\n  \
 mocap fuse simulate take.bvh --sensors 3 -o sim/\n  \
 mocap fuse calibrate sim/sensor-*.jsonl -o rig.toml\n  \
 mocap fuse measure sim/sensor-*.jsonl -o body.json\n  \
