@@ -32,11 +32,11 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand::seq::IndexedRandom;
 use rand::SeedableRng;
 
+use mocap_search::stratified_folds;
 use mocap_search::{
     argmax, load_clips, motion_files, ConfusionMatrix, Forest, ForestConfig, IntervalLayout,
     LabelRule, NamePattern, Samples,
 };
-use mocap_studies::search::stratified_folds;
 
 const N: usize = 10;
 

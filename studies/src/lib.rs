@@ -3,6 +3,4 @@
 //! doors, and what each study taught is written in `docs/research/`.
 
 pub mod clean;
-pub mod fuse;
-pub mod search;
 pub mod style;

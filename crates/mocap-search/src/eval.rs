@@ -233,7 +233,7 @@ pub struct EvalReport {
 
 /// Training and test clips of one fold, as indices into the clip list.
 #[derive(Debug, Clone)]
-pub(crate) struct Fold {
+pub struct Fold {
     pub train: Vec<usize>,
     pub test: Vec<usize>,
 }
@@ -386,13 +386,9 @@ fn label_indices(clips: &[Clip], classes: &[String]) -> Vec<u32> {
 /// Deals the clips of every class, shuffled, to `k` folds. The deal of each
 /// class starts where the previous class's ended, so that small classes do
 /// not all land in the first folds. `labels[i]` is clip `i`'s class, below
-/// `classes`; folds with no test or no training clip are left out.
-pub(crate) fn stratified_folds(
-    labels: &[u32],
-    classes: usize,
-    k: usize,
-    seed: u64,
-) -> Result<Vec<Fold>> {
+/// `classes`; folds with no test or no training clip are left out. Public so
+/// that another classifier can be tested on the very folds `evaluate` uses.
+pub fn stratified_folds(labels: &[u32], classes: usize, k: usize, seed: u64) -> Result<Vec<Fold>> {
     if k < 2 {
         return Err(SearchError::Invalid(format!(
             "cross-validation needs at least 2 folds, got {k}"

@@ -73,8 +73,9 @@ mod take;
 pub use clips::{load_clips, load_features, load_motion, motion_files, Clip};
 pub use error::{Result, SearchError};
 pub use eval::{
-    evaluate, evaluate_files, evaluate_train_test, EvalConfig, EvalReport, MethodScores,
-    NoveltyRow, RankingScores, SplitRule, TakeEvalReport, TakeMethodScores, UnseenReport,
+    evaluate, evaluate_files, evaluate_train_test, stratified_folds, EvalConfig, EvalReport, Fold,
+    MethodScores, NoveltyRow, RankingScores, SplitRule, TakeEvalReport, TakeMethodScores,
+    UnseenReport,
 };
 pub use features::{motion_features, VALUE_COUNT, VALUE_NAMES};
 pub use forest::{argmax, Forest, ForestConfig, Samples, Tree, TreeConfig};

@@ -1,1 +1,0 @@
-//! Setup shared by the fuse studies (`studies/examples/fuse_*.rs`).
