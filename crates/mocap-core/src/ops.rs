@@ -98,11 +98,6 @@ pub fn resample_fps(motion: &Motion, fps: f64) -> Result<Motion> {
     }
     let span_in_new_frames = (n - 1) as f64 * motion.frame_time() * fps;
     let count = (span_in_new_frames + ON_FRAME).floor() as usize + 1;
-    check_size(
-        motion,
-        count,
-        &format!("resampling to {fps} frames per second"),
-    )?;
     let step = frame_time / motion.frame_time();
     resample_at(motion, count, frame_time, |k| k as f64 * step)
 }
@@ -125,29 +120,11 @@ pub fn resample_frames(motion: &Motion, frame_count: usize) -> Result<Motion> {
             "cannot resample a one-frame motion to {frame_count} frames: it spans no time"
         )));
     }
-    check_size(
-        motion,
-        frame_count,
-        &format!("resampling to {frame_count} frames"),
-    )?;
     let span = (n - 1) as f64;
     let frame_time = motion.frame_time() * span / (frame_count - 1) as f64;
     resample_at(motion, frame_count, frame_time, |k| {
         k as f64 * span / (frame_count - 1) as f64
     })
-}
-
-/// Refuses an edit that would give `motion` `frames` frames holding more
-/// than [`MAX_VALUES`] channel values, before anything is allocated.
-fn check_size(motion: &Motion, frames: usize, edit: &str) -> Result<()> {
-    let channels = motion.skeleton().channel_count();
-    if frames.saturating_mul(channels) > MAX_VALUES {
-        return Err(Error::Invalid(format!(
-            "{edit} would make {frames} frames of {channels} channels, more than the \
-             {MAX_VALUES} values a motion may hold"
-        )));
-    }
-    Ok(())
 }
 
 fn source_frames(motion: &Motion) -> Result<usize> {
@@ -169,6 +146,13 @@ fn resample_at(
 ) -> Result<Motion> {
     let skeleton = motion.skeleton();
     let channels = skeleton.channel_count();
+    // Refused before anything is allocated (`--fps 1e9`).
+    if count.saturating_mul(channels) > MAX_VALUES {
+        return Err(Error::Invalid(format!(
+            "resampling to {count} frames of {channels} channels would make more than the \
+             {MAX_VALUES} values a motion may hold"
+        )));
+    }
     let last = motion.frame_count() - 1;
     let mut values = Vec::with_capacity(count * channels);
     // Frame k starts as a copy of the source frame at or before it; frames
