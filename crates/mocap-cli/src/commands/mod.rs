@@ -36,9 +36,7 @@ impl GlobalOptions {
         bar.set_message(message);
         bar
     }
-}
 
-impl GlobalOptions {
     /// Says so when `output` is one of `inputs`: writing there is allowed (a
     /// take cleaned in place), but a mistyped path loses a take, so the user
     /// is told which input the output replaces.
