@@ -1195,3 +1195,43 @@ fn style_train_adds_the_loss_on_the_feet_when_asked() {
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("foot loss"), "{}", stderr(&out));
 }
+
+#[test]
+fn a_damaged_model_file_is_refused_before_anything_is_written() {
+    // One exponent bit flipped in the last weight of each shipped model: the
+    // style model then wrote NaN values, the denoiser a take moved by tens of
+    // degrees, both with exit 0.
+    let dir = tempfile::tempdir().unwrap();
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let damaged = |name: &str| -> PathBuf {
+        let mut bytes = std::fs::read(models.join(name)).unwrap();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 0x40;
+        let copy = dir.path().join(name);
+        std::fs::write(&copy, bytes).unwrap();
+        copy
+    };
+    let walk = sample("dataset-1_walk_normal_001.bvh");
+    let proud = sample("dataset-1_walk_proud_001.bvh");
+    let output = dir.path().join("out.bvh");
+
+    let style_model = damaged("style-default.safetensors");
+    let out = style_apply(&walk, &proud, &output, &["--model", path(&style_model)]);
+    let message = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{message}");
+    assert!(
+        message.contains("style-default.safetensors: the file is damaged"),
+        "{message}"
+    );
+    assert!(!output.exists());
+
+    let clean_model = damaged("clean-default.safetensors");
+    let out = clean_walk_with(&clean_model, dir.path());
+    let message = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{message}");
+    assert!(
+        message.contains("clean-default.safetensors: the file is damaged"),
+        "{message}"
+    );
+    assert!(!dir.path().join("clean.bvh").exists());
+}

@@ -8,11 +8,16 @@
 //!   the layout of this header, bumped when it changes incompatibly;
 //! - `mocap.header`: a JSON [`CheckpointHeader`] with the kind of model (for
 //!   example `mocap-clean/denoiser`) and its own version, the model
-//!   configuration, and a description of the training data and run.
+//!   configuration, and a description of the training data and run;
+//! - `mocap.checksum`: `crc32:` and eight hex digits, the CRC-32 of the
+//!   `mocap.header` text followed by every byte after the safetensors header
+//!   (the tensors' data). A flipped bit in the weights or the configuration
+//!   gives a clear error instead of a network that quietly outputs garbage.
 //!
-//! The header is read first, the model built from its configuration, then the
-//! tensors are loaded into it; a tensor that is missing or of the wrong shape
-//! is an error naming the file.
+//! The header is read first and the checksum checked, the model built from its
+//! configuration, then the tensors are loaded into it; a tensor that is
+//! missing or of the wrong shape is an error naming the file. Files of format
+//! version 1 predate the checksum and are read without it.
 //!
 //! Training state for resuming ([`TrainingState`]) is kept apart: burn's own
 //! burnpack format for the weights (it keeps the parameter ids the optimizer
@@ -31,12 +36,15 @@ use crate::{NnError, Result};
 
 /// Value of the `mocap.format` metadata key.
 pub const FORMAT: &str = "mocap-nn checkpoint";
-/// Version of the header layout.
-pub const FORMAT_VERSION: u32 = 1;
+/// Version of the header layout: 2 added `mocap.checksum`.
+pub const FORMAT_VERSION: u32 = 2;
+/// The oldest header layout this build reads (without a checksum).
+const OLDEST_FORMAT_VERSION: u32 = 1;
 
 const KEY_FORMAT: &str = "mocap.format";
 const KEY_VERSION: &str = "mocap.format_version";
 const KEY_HEADER: &str = "mocap.header";
+const KEY_CHECKSUM: &str = "mocap.checksum";
 
 /// What a checkpoint holds, stored in its safetensors header.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -104,9 +112,53 @@ pub fn weights_to_bytes<M: Module>(
     module
         .save_into(&mut store)
         .map_err(|e| format!("cannot serialise the weights: {e}"))?;
-    store
+    let bytes = store
         .get_bytes()
-        .map_err(|e| format!("cannot serialise the weights: {e}"))
+        .map_err(|e| format!("cannot serialise the weights: {e}"))?;
+    seal(&bytes)
+}
+
+/// `bytes` (a checkpoint) with its header's `mocap.checksum` set to the
+/// checksum of its configuration and tensors, and its format version set to
+/// [`FORMAT_VERSION`]. The tensors' data is kept byte for byte: only the
+/// safetensors header is rewritten.
+pub fn seal(bytes: &[u8]) -> std::result::Result<Vec<u8>, String> {
+    let (header_len, _) = safetensors::SafeTensors::read_metadata(bytes)
+        .map_err(|e| format!("not a safetensors file ({e})"))?;
+    let data = &bytes[8 + header_len..];
+    let mut json: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_slice(&bytes[8..8 + header_len])
+            .map_err(|e| format!("bad safetensors header: {e}"))?;
+    let metadata = json
+        .entry("__metadata__")
+        .or_insert_with(|| serde_json::Value::Object(Default::default()))
+        .as_object_mut()
+        .ok_or("the safetensors `__metadata__` is not a map")?;
+    let header = metadata
+        .get(KEY_HEADER)
+        .and_then(|h| h.as_str())
+        .ok_or_else(|| format!("missing `{KEY_HEADER}`"))?;
+    let checksum = checksum(header, data);
+    metadata.insert(KEY_CHECKSUM.into(), checksum.into());
+    metadata.insert(KEY_VERSION.into(), FORMAT_VERSION.to_string().into());
+    let mut text = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
+    // safetensors pads its header with spaces so that the data starts on an
+    // 8-byte boundary.
+    text.resize(text.len().next_multiple_of(8), b' ');
+    let mut out = Vec::with_capacity(8 + text.len() + data.len());
+    out.extend_from_slice(&(text.len() as u64).to_le_bytes());
+    out.extend_from_slice(&text);
+    out.extend_from_slice(data);
+    Ok(out)
+}
+
+/// The `mocap.checksum` value of a checkpoint whose `mocap.header` is
+/// `header` and whose tensors' data is `data`.
+fn checksum(header: &str, data: &[u8]) -> String {
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(header.as_bytes());
+    hasher.update(data);
+    format!("crc32:{:08x}", hasher.finalize())
 }
 
 /// Reads the header of the checkpoint at `path`.
@@ -117,7 +169,7 @@ pub fn read_header(path: &Path) -> Result<CheckpointHeader> {
 
 /// Reads the header of checkpoint bytes; `origin` names them in errors.
 pub fn header_from_bytes(bytes: &[u8], origin: &Path) -> Result<CheckpointHeader> {
-    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+    let (header_len, metadata) = safetensors::SafeTensors::read_metadata(bytes)
         .map_err(|e| checkpoint_error(origin, format!("not a safetensors file ({e})")))?;
     let map = metadata.metadata().clone().unwrap_or_default();
     match map.get(KEY_FORMAT) {
@@ -141,17 +193,33 @@ pub fn header_from_bytes(bytes: &[u8], origin: &Path) -> Result<CheckpointHeader
         .get(KEY_VERSION)
         .and_then(|v| v.parse().ok())
         .ok_or_else(|| checkpoint_error(origin, format!("missing or bad `{KEY_VERSION}`")))?;
-    if version != FORMAT_VERSION {
+    if !(OLDEST_FORMAT_VERSION..=FORMAT_VERSION).contains(&version) {
         return Err(checkpoint_error(
             origin,
             format!(
-                "checkpoint format version {version}, this build reads version {FORMAT_VERSION}"
+                "checkpoint format version {version}, this build reads versions \
+                 {OLDEST_FORMAT_VERSION} to {FORMAT_VERSION}"
             ),
         ));
     }
     let header = map
         .get(KEY_HEADER)
         .ok_or_else(|| checkpoint_error(origin, format!("missing `{KEY_HEADER}`")))?;
+    if version >= 2 {
+        let stored = map
+            .get(KEY_CHECKSUM)
+            .ok_or_else(|| checkpoint_error(origin, format!("missing `{KEY_CHECKSUM}`")))?;
+        let actual = checksum(header, &bytes[8 + header_len..]);
+        if *stored != actual {
+            return Err(checkpoint_error(
+                origin,
+                format!(
+                    "the file is damaged: its checksum is {actual}, its header says {stored} \
+                     (copy or retrain the model)"
+                ),
+            ));
+        }
+    }
     serde_json::from_str(header)
         .map_err(|e| checkpoint_error(origin, format!("bad `{KEY_HEADER}` JSON: {e}")))
 }
@@ -407,5 +475,82 @@ mod tests {
             newer.contains("a Wiener filter version 1, this build reads version 2"),
             "{newer}"
         );
+    }
+
+    /// Checkpoint bytes of format version 1 (no checksum) holding one
+    /// tensor of four f32.
+    fn unsealed_checkpoint() -> Vec<u8> {
+        let values: Vec<u8> = [1.0f32, -2.0, 0.5, 3.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let view = safetensors::tensor::TensorView::new(safetensors::Dtype::F32, vec![4], &values)
+            .unwrap();
+        let header = CheckpointHeader {
+            kind: "test/model".into(),
+            kind_version: 1,
+            config: serde_json::json!({"width": 4}),
+            data: serde_json::Value::Null,
+            training: serde_json::Value::Null,
+        };
+        let metadata = std::collections::HashMap::from([
+            (KEY_FORMAT.to_string(), FORMAT.to_string()),
+            (KEY_VERSION.to_string(), "1".to_string()),
+            (
+                KEY_HEADER.to_string(),
+                serde_json::to_string(&header).unwrap(),
+            ),
+        ]);
+        safetensors::serialize([("w", view)], Some(metadata)).unwrap()
+    }
+
+    #[test]
+    fn a_sealed_checkpoint_reads_back_and_keeps_its_tensors() {
+        let old = unsealed_checkpoint();
+        let sealed = seal(&old).unwrap();
+        let header = header_from_bytes(&sealed, Path::new("m.safetensors")).unwrap();
+        assert_eq!(header.config, serde_json::json!({"width": 4}));
+        let (old_len, _) = safetensors::SafeTensors::read_metadata(&old).unwrap();
+        let (new_len, metadata) = safetensors::SafeTensors::read_metadata(&sealed).unwrap();
+        assert_eq!(old[8 + old_len..], sealed[8 + new_len..]);
+        let map = metadata.metadata().clone().unwrap();
+        assert_eq!(map[KEY_VERSION], FORMAT_VERSION.to_string());
+        assert!(map[KEY_CHECKSUM].starts_with("crc32:"), "{map:?}");
+        // Files written before checksums existed still load.
+        header_from_bytes(&old, Path::new("old.safetensors")).unwrap();
+    }
+
+    #[test]
+    fn a_flipped_bit_in_the_weights_or_the_configuration_is_refused() {
+        let sealed = seal(&unsealed_checkpoint()).unwrap();
+        let (header_len, _) = safetensors::SafeTensors::read_metadata(&sealed).unwrap();
+        let mut weights = sealed.clone();
+        // The exponent's top bit of the last f32.
+        let last = weights.len() - 1;
+        weights[last] ^= 0x40;
+        let e = header_from_bytes(&weights, Path::new("m.safetensors"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.safetensors: the file is damaged"), "{e}");
+
+        let mut config = sealed.clone();
+        let header_text = std::str::from_utf8(&config[8..8 + header_len]).unwrap();
+        let at = 8 + header_text.find("width").unwrap() + "width\\\":".len();
+        assert_eq!(config[at], b'4', "{header_text}");
+        config[at] = b'5';
+        let e = header_from_bytes(&config, Path::new("m.safetensors"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the file is damaged"), "{e}");
+
+        let mut no_checksum = sealed;
+        let text = std::str::from_utf8(&no_checksum[8..8 + header_len])
+            .unwrap()
+            .replace(KEY_CHECKSUM, "mocap.checksun");
+        no_checksum[8..8 + header_len].copy_from_slice(text.as_bytes());
+        let e = header_from_bytes(&no_checksum, Path::new("m.safetensors"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing `mocap.checksum`"), "{e}");
     }
 }
