@@ -69,6 +69,10 @@ fn main() -> ExitCode {
             libc::signal(libc::SIGPIPE, libc::SIG_DFL);
         }
     }
+    #[cfg(unix)]
+    remove_unfinished_files_on_signals(
+        !matches!(&cli.command, Command::Fuse(args) if args.finishes_on_ctrl_c()),
+    );
     // The libraries' own progress bars (training) obey --quiet too.
     mocap_nn::train::hide_progress(cli.quiet);
     for rig in &cli.rig {
@@ -96,6 +100,35 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// On Ctrl-C (when `ctrl_c`), `kill` or a closed terminal, removes the
+/// temporary files of the outputs being written, then ends the process with
+/// 128 + the signal's number, as a shell reports it. The outputs themselves
+/// are left as they were. `fuse serve` handles Ctrl-C itself: it finishes
+/// and writes the take.
+#[cfg(unix)]
+fn remove_unfinished_files_on_signals(ctrl_c: bool) {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut wanted = vec![SIGTERM, SIGHUP];
+    if ctrl_c {
+        wanted.push(SIGINT);
+    }
+    let Ok(mut signals) = signal_hook::iterator::Signals::new(&wanted) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            let removed = mocap_core::io::atomic::remove_unfinished_files();
+            if removed > 0 {
+                eprintln!(
+                    "interrupted: removed {removed} unfinished output file{}",
+                    if removed == 1 { "" } else { "s" }
+                );
+            }
+            std::process::exit(128 + signal);
+        }
+    });
 }
 
 #[cfg(test)]

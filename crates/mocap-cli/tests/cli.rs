@@ -250,3 +250,96 @@ fn output_to_a_closed_pipe_ends_quietly() {
     let err = stderr(&out);
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// The sample with its frames repeated `times` times (about 1 MB per
+/// repetition): a take whose writing lasts long enough to be interrupted.
+#[cfg(unix)]
+fn long_take(dir: &Path, times: usize) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(sample()).unwrap();
+    let (header, motion) = text.split_once("MOTION").unwrap();
+    let frames: Vec<&str> = motion
+        .lines()
+        .skip_while(|l| !l.starts_with("Frame Time"))
+        .collect();
+    let (frame_time, rows) = frames.split_first().unwrap();
+    let rows: Vec<&str> = rows
+        .iter()
+        .copied()
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    let mut out = format!(
+        "{header}MOTION\nFrames: {}\n{frame_time}\n",
+        rows.len() * times
+    );
+    for _ in 0..times {
+        for row in &rows {
+            out.push_str(row);
+            out.push('\n');
+        }
+    }
+    let path = dir.join("long.bvh");
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+/// Names of the hidden temporary files of `out.bvh` in `dir`.
+#[cfg(unix)]
+fn temp_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".out.bvh.") && n.ends_with(".tmp"))
+        .collect()
+}
+
+/// Ctrl-C or `kill` in the middle of a write removes the temporary file;
+/// after `kill -9`, which nothing can catch, the next write to the same path
+/// removes it.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_write_leaves_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = long_take(dir.path(), 60);
+    let output = dir.path().join("out.bvh");
+    // Starts `convert`, waits for its temporary file, sends the signal;
+    // `None` when the write finished before the signal came.
+    let interrupt = |signal: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_mocap"))
+            .args(["convert", input.to_str().unwrap(), output.to_str().unwrap()])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = std::time::Instant::now();
+        while temp_files(dir.path()).is_empty() {
+            assert!(started.elapsed().as_secs() < 60, "convert never wrote");
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        let kill = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        let status = child.wait().unwrap();
+        if status.success() {
+            std::fs::remove_file(&output).unwrap();
+            return None;
+        }
+        Some(status)
+    };
+    for (signal, code) in [("TERM", Some(143)), ("INT", Some(130)), ("KILL", None)] {
+        let status = (0..5)
+            .find_map(|_| interrupt(signal))
+            .unwrap_or_else(|| panic!("five writes ended before SIG{signal} came"));
+        assert_eq!(status.code(), code, "after SIG{signal}");
+        let left = temp_files(dir.path());
+        if signal == "KILL" {
+            assert_eq!(left.len(), 1, "{left:?}");
+            let out = mocap(&["convert", &sample(), output.to_str().unwrap()]);
+            assert!(out.status.success(), "{}", stderr(&out));
+            assert!(temp_files(dir.path()).is_empty());
+        } else {
+            assert!(left.is_empty(), "after SIG{signal}: {left:?}");
+            assert!(!output.exists(), "after SIG{signal}");
+        }
+    }
+}

@@ -36,6 +36,12 @@ impl Args {
     pub fn is_network(&self) -> bool {
         matches!(self.command, FuseCommand::Serve(_) | FuseCommand::Send(_))
     }
+
+    /// Whether this command ends on Ctrl-C by itself, writing what it has
+    /// (the server finishes its take).
+    pub fn finishes_on_ctrl_c(&self) -> bool {
+        matches!(self.command, FuseCommand::Serve(_))
+    }
 }
 
 #[derive(clap::Subcommand)]
