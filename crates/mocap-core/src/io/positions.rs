@@ -16,6 +16,7 @@ pub fn write_positions_csv(
     motion: &Motion,
     poses: &GlobalPoses,
 ) -> std::io::Result<()> {
+    check_finite(motion, poses)?;
     write!(out, "frame,time")?;
     for joint in motion.skeleton().joints() {
         let name = csv_field(&joint.name);
@@ -38,6 +39,7 @@ pub fn write_positions_json(
     motion: &Motion,
     poses: &GlobalPoses,
 ) -> std::io::Result<()> {
+    check_finite(motion, poses)?;
     let skeleton = motion.skeleton();
     write!(out, "{{\"frame_time\":{},\"joints\":[", motion.frame_time())?;
     for (i, joint) in skeleton.joints().iter().enumerate() {
@@ -64,6 +66,25 @@ pub fn write_positions_json(
     writeln!(out, "]}}")
 }
 
+/// Refuses positions that are not finite numbers (offsets and channel values
+/// near the largest floats overflow in forward kinematics), which neither
+/// CSV readers nor JSON could take, before anything is written.
+fn check_finite(motion: &Motion, poses: &GlobalPoses) -> std::io::Result<()> {
+    let Some(i) = poses.positions.iter().position(|p| !p.is_finite()) else {
+        return Ok(());
+    };
+    let joint = &motion.skeleton().joints()[i % poses.joint_count.max(1)].name;
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidData,
+        format!(
+            "the position of joint {joint} in frame {} is not a finite number ({}), \
+             so the positions cannot be written",
+            i / poses.joint_count.max(1),
+            poses.positions[i]
+        ),
+    ))
+}
+
 /// Quotes a CSV field when it holds a comma, quote or line break.
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
@@ -87,4 +108,32 @@ fn json_string(s: &str) -> String {
     }
     out.push('"');
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::bvh::read_bvh_from;
+    use crate::kinematics::forward_kinematics;
+
+    #[test]
+    fn positions_that_overflow_are_refused_before_anything_is_written() {
+        let text =
+            "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n\
+                    JOINT Spine\n{\nOFFSET 0 3e38 0\nCHANNELS 0\n\
+                    JOINT Head\n{\nOFFSET 0 3e38 0\nCHANNELS 0\n\
+                    End Site\n{\nOFFSET 0 1 0\n}\n}\n}\n}\n\
+                    MOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n";
+        let motion = read_bvh_from(text.as_bytes(), std::path::Path::new("far.bvh")).unwrap();
+        let poses = forward_kinematics(&motion);
+        for write in [write_positions_csv, write_positions_json] {
+            let mut out = Vec::new();
+            let e = write(&mut out, &motion, &poses).unwrap_err().to_string();
+            assert!(
+                e.starts_with("the position of joint Head in frame 0 is not a finite number"),
+                "{e}"
+            );
+            assert!(out.is_empty());
+        }
+    }
 }
