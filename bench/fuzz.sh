@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Fuzzes the BVH and ASF/AMC readers with cargo-fuzz (libFuzzer) and records
-# executions and crashes in bench/results/fuzz.md.
+# Fuzzes what reads untrusted bytes (files, model files, datagrams, HTTP
+# requests) with cargo-fuzz (libFuzzer) and records executions and crashes in
+# bench/results/fuzz.md.
 #
-# Usage: bench/fuzz.sh [SECONDS_PER_TARGET [TARGET...]]   (default 600, bvh asf_amc)
+# Usage: bench/fuzz.sh [SECONDS_PER_TARGET [TARGET...]]   (default 600, all targets)
 # Each target's latest run is kept as a row in bench/results/fuzz-rows/TARGET.md
 # and the report is assembled from all rows.
 # Needs: a nightly toolchain (`rustup toolchain install nightly`) and
@@ -12,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-600}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(bvh asf_amc)
+[ ${#targets[@]} -gt 0 ] || targets=($(sed -n 's/^name = "\(.*\)"$/\1/p' fuzz/Cargo.toml | grep -v mocap-fuzz))
 data=${MOCAP_SHARED_DATA:-../shared/data}
 
 # Seed corpora: real files from other exporters, and short Bandai/HDM05 pieces.
@@ -25,6 +26,16 @@ for f in "$data"/bandai/dataset-1/dataset-1_bow_normal_001.bvh; do
 done
 { cat "$data"/hdm05-sample/HDM_bd.asf; printf '\0'; head -n 95 "$data"/hdm05-sample/HDM_bd_depositFloorR_001_120.amc; } \
     > fuzz/corpus/asf_amc/hdm05_3frames
+# The shipped style model and Wiener filter (the denoiser, 20 MB, is too
+# slow to load a thousand times a second).
+mkdir -p fuzz/corpus/model_file
+cp models/style-default.safetensors models/clean-wiener.safetensors fuzz/corpus/model_file/
+# Small inputs committed beside the targets (requests, datagrams, NTU files).
+for dir in fuzz/seeds/*/; do
+    target=$(basename "$dir")
+    mkdir -p "fuzz/corpus/$target"
+    cp "$dir"* "fuzz/corpus/$target/"
+done
 
 report=bench/results/fuzz.md
 rows=bench/results/fuzz-rows
@@ -33,8 +44,10 @@ for target in "${targets[@]}"; do
     log=fuzz/$target.log
     rm -f fuzz/artifacts/$target/crash-*
     set +e
+    max_len=65536
+    [ "$target" = model_file ] && max_len=4194304
     cargo +nightly fuzz run "$target" "fuzz/corpus/$target" -- \
-        -max_total_time="$seconds" -max_len=65536 -print_final_stats=1 > "$log" 2>&1
+        -max_total_time="$seconds" -max_len=$max_len -print_final_stats=1 > "$log" 2>&1
     status=$?
     set -e
     execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
