@@ -105,7 +105,7 @@ impl DenoiserConfig {
     /// Channels of the input: the features and what the network is
     /// conditioned on.
     pub fn input_channels(&self) -> usize {
-        self.channels + self.extra_inputs
+        self.channels.saturating_add(self.extra_inputs)
     }
 
     /// Channels of the output: the features.
@@ -161,16 +161,33 @@ impl DenoiserConfig {
 
     /// Number of trainable numbers.
     pub fn parameter_count(&self) -> usize {
+        // Saturating: a damaged or hostile model file may ask for sizes whose
+        // count overflows; it is compared with the weights the file holds
+        // before anything is allocated.
         let k = self.kernel;
-        let conv = |cin: usize, cout: usize, k: usize| cin * cout * k + cout;
-        let block = |w: usize| 2 * conv(w, w, k);
-        let mut n = conv(self.input_channels(), self.width, k)
-            + conv(self.width, self.output_channels(), k);
-        for level in 0..self.levels {
-            let (w, w2) = (self.width_at(level), self.width_at(level + 1));
-            n += 2 * self.blocks * block(w) + conv(w, w2, 4) + (w2 * w * 4 + w);
+        let conv = |cin: usize, cout: usize, k: usize| {
+            cin.saturating_mul(cout)
+                .saturating_mul(k)
+                .saturating_add(cout)
+        };
+        let block = |w: usize| conv(w, w, k).saturating_mul(2);
+        let width_at = |level: usize| self.width.saturating_mul(1 << level.min(63));
+        let mut n = conv(self.input_channels(), self.width, k).saturating_add(conv(
+            self.width,
+            self.output_channels(),
+            k,
+        ));
+        for level in 0..self.levels.min(64) {
+            let (w, w2) = (width_at(level), width_at(level + 1));
+            n = n
+                .saturating_add(self.blocks.saturating_mul(block(w)).saturating_mul(2))
+                .saturating_add(conv(w, w2, 4))
+                .saturating_add(conv(w2, w, 4));
         }
-        n + self.blocks * block(self.width_at(self.levels))
+        n.saturating_add(
+            self.blocks
+                .saturating_mul(block(width_at(self.levels.min(63)))),
+        )
     }
 }
 

@@ -15,7 +15,8 @@ use burn::module::Module;
 use burn::tensor::Device;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
+    check_parameter_count, header_from_bytes, load_weights_from_bytes, save_weights,
+    CheckpointHeader,
 };
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
@@ -273,10 +274,22 @@ impl CleanModel {
                 }
             )));
         }
+        description.network.validate()?;
+        if let Some(wiener) = &description.base_wiener {
+            WienerFilter::check_description(wiener).map_err(bad)?;
+        }
+        let base_values = description
+            .base_wiener
+            .as_ref()
+            .map_or(0, WienerFilter::stored_value_count);
+        let wanted = description
+            .network
+            .parameter_count()
+            .saturating_add(base_values);
+        check_parameter_count(&bytes, origin, wanted)?;
         let device = device.device()?;
         let mut model = description.network.init(&device)?;
         if let Some(wiener) = &description.base_wiener {
-            WienerFilter::check_description(wiener).map_err(bad)?;
             if description.base_filter.is_some() {
                 return Err(bad("a base filter and a base Wiener filter at once".into()));
             }

@@ -93,7 +93,8 @@ use burn::module::{Module, Param};
 use burn::tensor::{Device, Tensor, TensorData};
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_weights, CheckpointHeader,
+    check_parameter_count, header_from_bytes, load_weights_from_bytes, save_weights,
+    CheckpointHeader,
 };
 use nalgebra::{Complex, DMatrix, DVector, SymmetricEigen};
 use rand::rngs::ChaCha8Rng;
@@ -1243,6 +1244,24 @@ impl WienerFilter {
         Ok(())
     }
 
+    /// How many numbers the tensors of `description` hold (saturating): a
+    /// damaged header is refused before [`WienerFilter::empty_tensors`]
+    /// allocates them.
+    pub(crate) fn stored_value_count(description: &WienerDescription) -> usize {
+        let c = description.channels;
+        let triangle = c.saturating_mul(c.saturating_add(1)) / 2;
+        let per_bin = if description.packed_spectra {
+            triangle.saturating_mul(2).saturating_sub(c)
+        } else {
+            c.saturating_mul(c).saturating_mul(2)
+        };
+        let bins = description
+            .component_count()
+            .saturating_mul(description.segment / 2 + 1);
+        bins.saturating_mul(per_bin)
+            .saturating_add(c.saturating_mul(c))
+    }
+
     /// Zeros of the shapes `description` stores, to load a file into.
     pub(crate) fn empty_tensors(description: &WienerDescription) -> WienerTensors {
         let device = Device::flex();
@@ -1336,6 +1355,7 @@ impl WienerFilter {
         let description: WienerDescription = serde_json::from_value(header.config)
             .map_err(|e| bad(format!("bad Wiener filter description: {e}")))?;
         Self::check_description(&description).map_err(bad)?;
+        check_parameter_count(&bytes, origin, Self::stored_value_count(&description))?;
         let empty = Self::empty_tensors(&description);
         let tensors = load_weights_from_bytes(bytes, origin, empty)?;
         Self::from_tensors(description, tensors).map_err(bad)

@@ -224,6 +224,26 @@ pub fn header_from_bytes(bytes: &[u8], origin: &Path) -> Result<CheckpointHeader
         .map_err(|e| checkpoint_error(origin, format!("bad `{KEY_HEADER}` JSON: {e}")))
 }
 
+/// Refuses a configuration that asks for more weights than the checkpoint
+/// holds, before the model is built: a damaged or hostile header must not
+/// make the loader allocate what the file does not justify. `wanted` is the
+/// configuration's parameter count (saturating).
+pub fn check_parameter_count(bytes: &[u8], origin: &Path, wanted: usize) -> Result<()> {
+    let tensors = safetensors::SafeTensors::deserialize(bytes)
+        .map_err(|e| checkpoint_error(origin, format!("not a safetensors file ({e})")))?;
+    let stored: usize = tensors
+        .iter()
+        .map(|(_, view)| view.shape().iter().product::<usize>())
+        .sum();
+    if wanted > stored {
+        return Err(checkpoint_error(
+            origin,
+            format!("the model configuration asks for {wanted} weights, the file holds {stored}"),
+        ));
+    }
+    Ok(())
+}
+
 /// Loads the weights in `bytes` into `module` (built from the header's
 /// configuration). Every tensor of the module must be present with its shape.
 pub fn load_weights_from_bytes<M: Module>(

@@ -76,12 +76,16 @@ impl AutoencoderConfig {
         })
     }
 
-    /// Number of trainable numbers.
+    /// Number of trainable numbers. Saturating: a damaged or hostile model
+    /// file may ask for sizes whose count overflows; it is compared with the
+    /// weights the file holds before anything is allocated.
     pub fn parameter_count(&self) -> usize {
-        self.channels * self.hidden * self.kernel
-            + self.hidden
-            + self.hidden * self.latent
-            + self.latent
+        self.channels
+            .saturating_mul(self.hidden)
+            .saturating_mul(self.kernel)
+            .saturating_add(self.hidden)
+            .saturating_add(self.hidden.saturating_mul(self.latent))
+            .saturating_add(self.latent)
     }
 }
 

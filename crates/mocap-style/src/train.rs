@@ -24,7 +24,8 @@ use mocap_core::ops::resample_fps;
 use mocap_core::rotation::Quat;
 use mocap_core::Motion;
 use mocap_nn::checkpoint::{
-    header_from_bytes, load_weights_from_bytes, save_epoch, start_run, CheckpointHeader, RunStart,
+    check_parameter_count, header_from_bytes, load_weights_from_bytes, save_epoch, start_run,
+    CheckpointHeader, RunStart,
 };
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
@@ -188,6 +189,8 @@ impl StyleModel {
         )?;
         let description: ModelDescription = serde_json::from_value(header.config)
             .map_err(|e| invalid(format!("{}: bad model description: {e}", origin.display())))?;
+        description.network.validate()?;
+        check_parameter_count(&bytes, origin, description.network.parameter_count())?;
         let device = device.device()?;
         let network = description.network.init(&device)?;
         let network = load_weights_from_bytes(bytes, origin, network)?;
@@ -640,5 +643,51 @@ fn validation_mse(
         f64::NAN
     } else {
         sum / count as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shipped model with `edit` applied to its header's configuration,
+    /// resealed, as a file damaged before it was written would be.
+    fn with_config(edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+        let n = u64::from_le_bytes(DEFAULT_MODEL[..8].try_into().unwrap()) as usize;
+        let mut outer: serde_json::Value =
+            serde_json::from_slice(&DEFAULT_MODEL[8..8 + n]).unwrap();
+        let metadata = &mut outer["__metadata__"];
+        let mut header: serde_json::Value =
+            serde_json::from_str(metadata["mocap.header"].as_str().unwrap()).unwrap();
+        edit(&mut header["config"]);
+        metadata["mocap.header"] = header.to_string().into();
+        let text = outer.to_string();
+        let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
+        bytes.extend_from_slice(text.as_bytes());
+        bytes.extend_from_slice(&DEFAULT_MODEL[8 + n..]);
+        mocap_nn::checkpoint::seal(&bytes).unwrap()
+    }
+
+    #[test]
+    fn a_configuration_larger_than_the_weights_in_the_file_is_refused_before_allocating() {
+        let origin = Path::new("big.safetensors");
+        // The shipped configuration loads.
+        StyleModel::from_bytes(with_config(|_| {}), origin, DeviceChoice::Cpu).unwrap();
+        let hidden = with_config(|config| config["network"]["hidden"] = (1u64 << 40).into());
+        let e = StyleModel::from_bytes(hidden, origin, DeviceChoice::Cpu)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("big.safetensors: the model configuration asks for"),
+            "{e}"
+        );
+        let huge = with_config(|config| {
+            config["network"]["channels"] = u64::MAX.into();
+            config["network"]["kernel"] = (u64::MAX - 2).into();
+        });
+        let e = StyleModel::from_bytes(huge, origin, DeviceChoice::Cpu)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("asks for 18446744073709551615 weights"), "{e}");
     }
 }
