@@ -46,4 +46,8 @@ pub use plots::{
 };
 pub use render::{confidence_colour, render, render_files, Layout, RenderOptions, RenderSummary};
 pub use scene::{guess_metres_per_unit, read_capture, Scene, ViewMotion, PALETTE};
+/// One connection of the viewer over any byte stream, for the fuzz target
+/// `viewer_request`; not part of the API.
+#[doc(hidden)]
+pub use server::serve_connection;
 pub use server::{serve, ViewerServer};
