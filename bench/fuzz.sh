@@ -57,12 +57,19 @@ for target in "${targets[@]}"; do
     echo "| $target | $(date -u +%F) | $seconds | $execs | $rate | $corpus | $crashes (exit $status) |" > "$rows/$target.md"
 done
 {
-    echo "# Fuzzing the readers"
+    echo "# Fuzzing what reads untrusted bytes"
     echo
     echo "Made by \`bench/fuzz.sh SECONDS [TARGET...]\` (libFuzzer via cargo-fuzz $(cargo fuzz --version 2>/dev/null | awk '{print $2}'), $(rustc +nightly --version)),"
     echo "on $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) cores, shared with other builds (exec/s is therefore low)."
-    echo "Seeds: the parser-case BVH files, a truncated and a 2-frame Bandai file, the HDM05 ASF with 3 AMC frames."
-    echo "The bvh target also checks that every motion it reads writes back and reads again bit for bit."
+    echo
+    echo "| target | what it feeds | seeds |"
+    echo "| --- | --- | --- |"
+    echo "| bvh | the BVH reader; what it reads must write back and read again to the same motion | parser-case files, a truncated and a 2-frame Bandai take |"
+    echo "| asf_amc | the ASF and AMC readers (input split at the first NUL) | the HDM05 ASF with 3 AMC frames |"
+    echo "| model_file | the denoiser, Wiener filter and style model loaders, each input as it is and resealed (checksum recomputed) | the shipped style model and Wiener filter |"
+    echo "| viewer_request | one connection to the web viewer's HTTP server, on a paused clock | fuzz/seeds/viewer_request |"
+    echo "| fuse_datagram | datagrams decoded and pushed through the fusion server's timeline | fuzz/seeds/fuse_datagram |"
+    echo "| ntu_skeleton | the NTU RGB+D .skeleton reader | fuzz/seeds/ntu_skeleton |"
     echo
     echo "| target | date | seconds | executions | exec/s | corpus entries | crashes |"
     echo "| --- | --- | ---: | ---: | ---: | ---: | ---: |"
