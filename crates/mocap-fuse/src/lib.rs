@@ -140,10 +140,12 @@ pub use kinect::{
     guess_units_per_metre, joint, joint_index, truth_from_motion, GroundTruth, TrackingState,
     JOINT_COUNT, JOINT_NAMES, MIRROR, PARENTS, TOPOLOGICAL_ORDER,
 };
+#[doc(hidden)]
+pub use net::ServerCore;
 pub use net::{
     decode_datagram, encode_datagram, runtime, send, send_blocking, send_files, serve,
     serve_blocking, serve_blocking_with, serve_files, SendOptions, SendReport, ServeFilesOptions,
-    ServeFilesReport, ServeOptions, ServeReport, MAGIC,
+    ServeFilesReport, ServeOptions, ServeReport, DEFAULT_MAX_SKEW, MAGIC, MAX_TIMESTAMP,
 };
 pub use offline::{
     fuse_files, fuse_recordings, fuse_streams, views_at, FuseFilesOptions, FuseFilesReport,
