@@ -284,6 +284,244 @@ fn serve_and_send_over_loopback() {
     assert!(motion.frame_count() > 180);
 }
 
+/// A hostile datagram for [`serve_a_take_with`]: sent before the take's
+/// first datagram (`at` 0.0) or after that fraction of its datagrams.
+struct Hostile {
+    at: f64,
+    datagram: Vec<u8>,
+}
+
+/// A sensor frame of the take (sensor 0's first), with `seq` changed so
+/// that it is no duplicate, then edited.
+fn edited_frame(
+    sim: &Path,
+    seq: u64,
+    edit: impl FnOnce(&mut mocap_fuse::SensorFrame),
+) -> mocap_fuse::SensorFrame {
+    let mut frame = mocap_fuse::read_recording(&sim.join("sensor-0.jsonl")).unwrap()[0].clone();
+    frame.seq = seq;
+    edit(&mut frame);
+    frame
+}
+
+/// What [`serve_a_take_with`] saw.
+struct Served {
+    report: serde_json::Value,
+    /// Fused frames in the BVH output.
+    bvh_frames: usize,
+    /// Fused frames the take spans at 30 fps.
+    take_frames: usize,
+    /// The largest coordinate of the fused joints (m).
+    largest: f64,
+    /// Mean distance of the fused joints to the truth (m).
+    error: f64,
+}
+
+/// Runs `mocap fuse serve` on 127.0.0.1, replays the simulated take to it
+/// at 4 times real time with the hostile datagrams among its own, and waits
+/// for the server to stop by itself (`--idle-exit 1`) within 20 seconds of
+/// the last datagram; kills it and fails otherwise.
+fn serve_a_take_with(hostile: impl FnOnce(&Path) -> Vec<Hostile>) -> Served {
+    use std::net::UdpSocket;
+    let (dir, sim) = simulated(&[]);
+    let hostile = hostile(&sim);
+    let d = dir.path();
+    let live = d.join("live.jsonl");
+    let live_bvh = d.join("live.bvh");
+    let mut server = Command::new(env!("CARGO_BIN_EXE_mocap"))
+        .args([
+            "fuse",
+            "serve",
+            "--calib",
+            &s(&sim.join("truth.calib.toml")),
+            "--body",
+            &s(&sim.join("body.json")),
+            "--listen",
+            "127.0.0.1:0",
+            "-o",
+            &s(&live),
+            "-o",
+            &s(&live_bvh),
+            "--idle-exit",
+            "1",
+            "--duration",
+            "60",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(server.stderr.take().unwrap()).lines();
+    let addr = loop {
+        let line = lines
+            .next()
+            .expect("the server prints its address")
+            .unwrap();
+        if let Some(rest) = line.split("listening on ").nth(1) {
+            break rest.split_whitespace().next().unwrap().to_string();
+        }
+    };
+    // The rest of standard error, read as it comes so that the server
+    // never blocks on a full pipe.
+    let log = std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>());
+    let paths: Vec<PathBuf> = recordings(&sim).iter().map(PathBuf::from).collect();
+    let mut frames = mocap_fuse::read_recordings(&paths).unwrap();
+    let when = |f: &mocap_fuse::SensorFrame| f.arrival.unwrap_or(f.timestamp);
+    frames.sort_by(|a, b| when(a).total_cmp(&when(b)));
+    let (first, last) = frames.iter().fold((f64::MAX, f64::MIN), |(lo, hi), f| {
+        (lo.min(f.timestamp), hi.max(f.timestamp))
+    });
+    let take_frames = ((last * 30.0).floor() - (first * 30.0).ceil()) as usize + 1;
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let started = Instant::now();
+    let t0 = when(&frames[0]);
+    let mut hostile = hostile;
+    hostile.sort_by(|a, b| a.at.total_cmp(&b.at));
+    let mut hostile = hostile.into_iter().peekable();
+    for (i, f) in frames.iter().enumerate() {
+        while let Some(h) = hostile.next_if(|h| h.at * frames.len() as f64 <= i as f64) {
+            socket.send_to(&h.datagram, &addr).unwrap();
+        }
+        let due = started + Duration::from_secs_f64(((when(f) - t0) / 4.0).max(0.0));
+        std::thread::sleep(due.saturating_duration_since(Instant::now()));
+        socket
+            .send_to(&mocap_fuse::encode_datagram(f), &addr)
+            .unwrap();
+    }
+    let sent = Instant::now();
+    let status = loop {
+        if let Some(status) = server.try_wait().unwrap() {
+            break status;
+        }
+        if sent.elapsed() > Duration::from_secs(20) {
+            server.kill().unwrap();
+            server.wait().unwrap();
+            let size = |p: &Path| std::fs::metadata(p).map_or(0, |m| m.len());
+            let temp: u64 = std::fs::read_dir(d)
+                .unwrap()
+                .map(|e| size(&e.unwrap().path()))
+                .sum();
+            panic!(
+                "the server did not stop within 20 s of the take's end ({temp} bytes in its folder): {:?}",
+                log.join().unwrap()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(&mut server.stdout.take().unwrap(), &mut stdout).unwrap();
+    let log = log.join().unwrap();
+    assert!(status.success(), "{log:?}");
+    assert!(
+        log.len() <= 20,
+        "the server floods its standard error: {log:?}"
+    );
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let bvh_frames = mocap_core::io::bvh::read_bvh(&live_bvh)
+        .unwrap()
+        .frame_count();
+    let largest = std::fs::read_to_string(&live)
+        .unwrap()
+        .lines()
+        .flat_map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            let joints: Vec<f64> = v["joints"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|j| j.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()))
+                .collect();
+            joints
+        })
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    let error = mean_distance(&live, &sim.join("truth.jsonl"));
+    Served {
+        report,
+        bvh_frames,
+        take_frames,
+        largest,
+        error,
+    }
+}
+
+/// The take's frames, no more: a few at either end may be lost to the
+/// timing of a replay.
+fn assert_the_take_alone(served: &Served) {
+    let Served {
+        bvh_frames,
+        take_frames,
+        ..
+    } = *served;
+    eprintln!(
+        "{bvh_frames} frames in the BVH for a take of {take_frames}; largest coordinate {:.2} m; {:.1} mm from the truth",
+        served.largest,
+        served.error * 1000.0
+    );
+    assert!(
+        bvh_frames <= take_frames + 1 && bvh_frames + 5 >= take_frames,
+        "{bvh_frames} frames in the BVH for a take of {take_frames}: {}",
+        served.report
+    );
+    assert!(
+        served.largest < 10.0,
+        "a fused joint at {} m",
+        served.largest
+    );
+    assert!(served.error < 0.08, "{} m from the truth", served.error);
+}
+
+/// The sensor frame at `at` (fraction of the take's datagrams) as a
+/// hostile datagram, edited.
+fn hostile_frame(
+    at: f64,
+    edit: impl FnOnce(&mut mocap_fuse::SensorFrame),
+) -> impl FnOnce(&Path) -> Vec<Hostile> {
+    move |sim| {
+        let datagram = mocap_fuse::encode_datagram(&edited_frame(sim, 1_000_000, edit));
+        vec![Hostile { at, datagram }]
+    }
+}
+
+#[test]
+fn serve_drops_a_first_datagram_from_the_far_future() {
+    let served = serve_a_take_with(hostile_frame(0.0, |f| f.timestamp = 1e30));
+    assert_the_take_alone(&served);
+    assert_eq!(served.report["server"]["implausible_time"], 1);
+}
+
+#[test]
+fn serve_drops_a_first_datagram_from_the_far_past() {
+    let served = serve_a_take_with(hostile_frame(0.0, |f| f.timestamp = -1e30));
+    assert_the_take_alone(&served);
+    assert_eq!(served.report["server"]["implausible_time"], 1);
+}
+
+#[test]
+fn serve_drops_a_datagram_hours_ahead_mid_stream() {
+    let served = serve_a_take_with(hostile_frame(0.5, |f| f.timestamp = 1e4));
+    assert_the_take_alone(&served);
+    assert_eq!(served.report["server"]["implausible_time"], 1);
+}
+
+#[test]
+fn serve_never_fuses_joints_at_absurd_distances() {
+    // Sensor 0 in the middle of the take, every joint Tracked at 1e30 m.
+    let served = serve_a_take_with(|sim| {
+        let frames = mocap_fuse::read_recording(&sim.join("sensor-0.jsonl")).unwrap();
+        let middle = frames[frames.len() / 2].timestamp;
+        hostile_frame(0.5, |f| {
+            f.timestamp = middle;
+            for j in f.joints.iter_mut() {
+                j.position = mocap_core::rotation::Vec3::splat(1e30);
+                j.state = mocap_fuse::TrackingState::Tracked;
+            }
+        })(sim)
+    });
+    assert_the_take_alone(&served);
+    assert_eq!(served.report["server"]["implausible_frames"], 1);
+}
+
 #[test]
 fn calibrate_one_room_scan_against_another() {
     let (dir, sim) = simulated(&[]);

@@ -117,6 +117,9 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
         fps: simulation.fps,
         wait: 0.1,
         sensor_timeout: 0.5,
+        // A replay faster than real time runs ahead of the server's clock
+        // by up to the take's length.
+        max_skew: mocap_fuse::DEFAULT_MAX_SKEW + truth.duration(),
         // A safety net: the replay takes well under this.
         duration: Some(Duration::from_secs_f64(
             truth.duration() / options.send_speed.max(0.1) + 20.0,

@@ -73,6 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fps: 30.0,
             wait: 0.1,
             sensor_timeout: 0.5,
+            max_skew: mocap_fuse::DEFAULT_MAX_SKEW,
             duration: Some(Duration::from_secs_f64(seconds + 1.5)),
             idle_exit: None,
         };

@@ -866,6 +866,7 @@ pub fn evaluate_consistency(
     fps: f64,
 ) -> Result<ConsistencyReport> {
     let streams = SensorStreams::new(frames);
+    streams.check_span(fps)?;
     if streams.streams.len() < 2 {
         return Err(Error::Invalid(format!(
             "{take}: fusion needs at least two sensors, found {}",

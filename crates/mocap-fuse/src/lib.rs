@@ -140,14 +140,16 @@ pub use kinect::{
     guess_units_per_metre, joint, joint_index, truth_from_motion, GroundTruth, TrackingState,
     JOINT_COUNT, JOINT_NAMES, MIRROR, PARENTS, TOPOLOGICAL_ORDER,
 };
+#[doc(hidden)]
+pub use net::ServerCore;
 pub use net::{
     decode_datagram, encode_datagram, runtime, send, send_blocking, send_files, serve,
     serve_blocking, serve_blocking_with, serve_files, SendOptions, SendReport, ServeFilesOptions,
-    ServeFilesReport, ServeOptions, ServeReport, MAGIC,
+    ServeFilesReport, ServeOptions, ServeReport, DEFAULT_MAX_SKEW, MAGIC, MAX_TIMESTAMP,
 };
 pub use offline::{
     fuse_files, fuse_recordings, fuse_streams, views_at, FuseFilesOptions, FuseFilesReport,
-    SensorStreams,
+    SensorStreams, MAX_FUSED_FRAMES,
 };
 pub use output::{
     fused_frame_json, FrameSink, FusedOutputs, JsonlSink, MemorySink, OutputFiles, OutputFormat,
@@ -155,8 +157,9 @@ pub use output::{
 };
 pub use ply::{read_ply_points, write_ply_points, PlyEncoding};
 pub use recording::{
-    ntu_sensor_frames, read_any_recording, read_ntu_skeleton, read_recording, read_recordings,
-    write_ntu_skeleton, write_recording, JointObservation, NtuBody, SensorFrame, RECORDING_VERSION,
+    ntu_sensor_frames, read_any_recording, read_ntu_skeleton, read_ntu_skeleton_from,
+    read_recording, read_recordings, write_ntu_skeleton, write_recording, JointObservation,
+    NtuBody, SensorFrame, MAX_JOINT_DISTANCE, RECORDING_VERSION,
 };
 pub use sim::{
     center_truth, measure_person, room_points, sensor_point_cloud, simulate, simulate_capture,

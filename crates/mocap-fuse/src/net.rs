@@ -22,12 +22,55 @@
 //! simply starts to contribute. Duplicates (same sensor and seq) are dropped;
 //! reordered frames are put in order; a frame for an instant already fused
 //! is counted as late.
+//!
+//! # Judging a datagram's time
+//!
+//! A datagram's time `t` is the sensor's word; one wrong time (`t` = 1e30,
+//! or 1e4 in the middle of a take) must not make the server fuse millions
+//! of instants or call the real frames late. So the server keeps its own
+//! reckoning of the sensors' (shared) clock: the offset `t - s` between a
+//! datagram's time and the server's clock `s` when it arrived (seconds
+//! since the server started). A live sensor's offset is its clock's
+//! difference to the server's minus its latency, nearly constant; the
+//! server keeps the lowest offset of the frames it accepted (the one that
+//! took longest to come), and the *lead* of a datagram is how much its own
+//! offset exceeds that: how far its time is ahead of what the server's
+//! elapsed time allows since the frames before it.
+//!
+//! - A time that is not finite, or beyond [`MAX_TIMESTAMP`] either way, is
+//!   implausible.
+//! - The clock is set by the first two datagrams (not one datagram sent
+//!   twice) whose offsets agree within `max_skew`; until then up to eight
+//!   wait. So a lone wrong first datagram sets nothing: it is dropped as
+//!   implausible once two others agree without it.
+//! - Then a datagram whose lead is more than `max_skew` (default
+//!   [`DEFAULT_MAX_SKEW`]) ahead or behind is implausible. A live sensor
+//!   leads by its latency jitter; a replay at `k` times real time by
+//!   `1 - 1/k` of the time it has sent; a slower replay never leads (the
+//!   lowest offset follows it down).
+//!
+//! Implausible datagrams are counted (`implausible_time`), the first few
+//! printed on standard error like malformed ones, and dropped. Instants are
+//! counted, not summed (`index * period`), and a drain never fuses an
+//! instant later than the sensors' clock now plus `max_skew`, nor more
+//! instants than the time since the previous drain allows plus a burst
+//! worth `max_skew` and a second: whatever datagrams come, each one costs a
+//! bounded amount of work and output, and the server answers Ctrl-C.
+//!
+//! # Implausible joints
+//!
+//! Every frame is screened as the offline fusion screens it
+//! ([`SensorFrame::screen_implausible_joints`]): a joint farther than
+//! [`crate::MAX_JOINT_DISTANCE`] from its sensor is fused as NotTracked
+//! (`implausible_joints`), and a frame with no plausible joint is dropped
+//! (`implausible_frames`).
 
-use std::collections::{BTreeMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, HashSet, VecDeque};
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use mocap_core::error::printable;
 use mocap_core::{Error, Result};
 use serde::{Deserialize, Serialize};
 use tokio::net::UdpSocket;
@@ -35,6 +78,7 @@ use tokio::net::UdpSocket;
 use crate::body::BodyModel;
 use crate::calib::Calibration;
 use crate::fusion::{Fuser, FusionOptions, SensorView};
+use crate::kinect::JOINT_COUNT;
 use crate::offline::sample_stream;
 use crate::output::{FrameSink, FusedOutputs, OutputFiles, OutputReport};
 use crate::recording::{read_recordings, JointObservation, SensorFrame};
@@ -63,6 +107,30 @@ pub fn decode_datagram(bytes: &[u8]) -> std::result::Result<SensorFrame, String>
     SensorFrame::from_json(text)
 }
 
+/// How far, by default, a datagram's time may be ahead of or behind the
+/// sensors' clock as the server reckons it, in seconds (see the module
+/// documentation). A live sensor is never more than its latency behind;
+/// ten seconds leaves room for a replay at a few times real time.
+pub const DEFAULT_MAX_SKEW: f64 = 10.0;
+
+/// The largest time (seconds, either sign) a datagram may carry: 317 years,
+/// enough for Unix time. Below it a period of a millisecond is still
+/// thousands of times the resolution of an `f64`, so instants stay distinct.
+pub const MAX_TIMESTAMP: f64 = 1e10;
+
+/// The fastest frame rate the server fuses at (frames per second).
+const MAX_FPS: f64 = 1000.0;
+
+/// The longest `wait`, `sensor_timeout` or `max_skew` (seconds): an hour.
+const MAX_SECONDS: f64 = 3600.0;
+
+/// Datagrams kept while the clock is not set yet (see the module
+/// documentation); older ones are dropped.
+const HELD_BEFORE_CLOCK: usize = 8;
+
+/// Problems of each kind printed on standard error; the rest are counted.
+const LOGGED_PER_KIND: u64 = 5;
+
 /// Options of the fusion server.
 #[derive(Debug, Clone)]
 pub struct ServeOptions {
@@ -70,7 +138,7 @@ pub struct ServeOptions {
     pub calibration: Calibration,
     pub body: BodyModel,
     pub fusion: FusionOptions,
-    /// Output instants per second (the sensors' frame rate).
+    /// Output instants per second (the sensors' frame rate), 0.1 to 1000.
     pub fps: f64,
     /// Seconds (sensor clock) past an instant after which it is fused
     /// without waiting for slower sensors.
@@ -78,6 +146,11 @@ pub struct ServeOptions {
     /// Seconds (sensor clock) behind the newest frame after which a sensor
     /// counts as gone.
     pub sensor_timeout: f64,
+    /// Seconds a datagram's time may be ahead of or behind the sensors'
+    /// clock as the server reckons it ([`DEFAULT_MAX_SKEW`]; see the module
+    /// documentation). A replay faster than real time runs ahead by the
+    /// take's length times `1 - 1/speed`.
+    pub max_skew: f64,
     /// Stop after this long (wall clock); `None`: until the shutdown signal.
     pub duration: Option<Duration>,
     /// Stop when no datagram has come for this long after the first one
@@ -85,7 +158,34 @@ pub struct ServeOptions {
     pub idle_exit: Option<Duration>,
 }
 
-/// What the server saw and did.
+impl ServeOptions {
+    /// Checks the numbers: a frame rate of 0.1 to 1000 per second, and
+    /// `wait`, `sensor_timeout` and `max_skew` of at most an hour.
+    pub fn check(&self) -> Result<()> {
+        if !(self.fps.is_finite() && (0.1..=MAX_FPS).contains(&self.fps)) {
+            return Err(Error::Invalid(format!(
+                "the frame rate must be 0.1 to {MAX_FPS} frames per second, got {}",
+                self.fps
+            )));
+        }
+        for (name, value, least) in [
+            ("wait", self.wait, 0.0),
+            ("sensor timeout", self.sensor_timeout, 0.0),
+            ("max skew", self.max_skew, 1.0 / self.fps),
+        ] {
+            if !(value.is_finite() && (least..=MAX_SECONDS).contains(&value)) {
+                return Err(Error::Invalid(format!(
+                    "the {name} must be {least} to {MAX_SECONDS} seconds, got {value}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the server saw and did. Every datagram is counted once: in
+/// `malformed`, `uncalibrated`, `implausible_time`, `implausible_frames`,
+/// `duplicates`, `late`, `overflow` or `frames_accepted`.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct ServeReport {
     pub datagrams: u64,
@@ -95,6 +195,23 @@ pub struct ServeReport {
     pub uncalibrated: u64,
     /// Frames for instants already fused.
     pub late: u64,
+    /// Datagrams whose time does not fit the sensors' clock (see the
+    /// module documentation): dropped.
+    #[serde(default)]
+    pub implausible_time: u64,
+    /// Frames none of whose joints was within [`crate::MAX_JOINT_DISTANCE`]
+    /// of the sensor: dropped.
+    #[serde(default)]
+    pub implausible_frames: u64,
+    /// Joints of accepted frames farther than [`crate::MAX_JOINT_DISTANCE`]
+    /// from their sensor, fused as NotTracked
+    /// ([`SensorFrame::screen_implausible_joints`]).
+    #[serde(default)]
+    pub implausible_joints: u64,
+    /// Frames beyond what a sensor can have sent in the time the server
+    /// keeps (a flood): dropped.
+    #[serde(default)]
+    pub overflow: u64,
     pub fused_frames: u64,
     pub sensors_seen: Vec<u16>,
     /// Joint observations that went into fused frames.
@@ -107,66 +224,93 @@ pub struct ServeReport {
     pub latency_max_ms: f64,
 }
 
+/// Why the timeline did not take a frame.
+enum Refusal {
+    Duplicate,
+    Late,
+    Overflow,
+}
+
 /// Per-sensor state of the server.
 #[derive(Default)]
 struct SensorState {
-    frames: VecDeque<SensorFrame>,
+    /// In time order.
+    frames: Vec<SensorFrame>,
     seen: HashSet<u64>,
     latest: f64,
 }
 
-/// The timeline: sensor streams and the next instant to fuse.
-pub struct Timeline {
+/// The timeline: sensor streams and the next instant to fuse. Instants are
+/// counted (`index * period`), never summed, so that every step moves on.
+struct Timeline {
     sensors: BTreeMap<u16, SensorState>,
-    next_instant: Option<f64>,
+    next_index: Option<i64>,
     period: f64,
     wait: f64,
     sensor_timeout: f64,
-    /// Accepted frames not yet covered by a fused instant: (timestamp, arrival).
-    pending: VecDeque<(f64, Instant)>,
+    /// The most frames a sensor may have waiting.
+    capacity: usize,
+    /// Accepted frames not yet covered by a fused instant: (timestamp,
+    /// arrival in server seconds).
+    pending: VecDeque<(f64, f64)>,
 }
 
 impl Timeline {
-    pub fn new(fps: f64, wait: f64, sensor_timeout: f64) -> Timeline {
+    fn new(options: &ServeOptions) -> Timeline {
+        // Frames a sensor keeps: those of the last few periods, and those up
+        // to `max_skew` ahead; four times that at its frame rate is more
+        // than a live sensor (or a replay) can have sent.
+        let span = 2.0 * options.max_skew + options.wait + options.sensor_timeout + 1.0;
         Timeline {
             sensors: BTreeMap::new(),
-            next_instant: None,
-            period: 1.0 / fps,
-            wait,
-            sensor_timeout,
+            next_index: None,
+            period: 1.0 / options.fps,
+            wait: options.wait,
+            sensor_timeout: options.sensor_timeout,
+            capacity: (4.0 * span * options.fps).ceil() as usize + 16,
             pending: VecDeque::new(),
         }
     }
 
-    /// Adds a frame; says why it was not taken.
-    pub fn push(
-        &mut self,
-        frame: SensorFrame,
-        arrival: Instant,
-    ) -> std::result::Result<(), &'static str> {
+    fn instant(&self, index: i64) -> f64 {
+        index as f64 * self.period
+    }
+
+    /// Adds a frame (arrived at `arrival`, server seconds).
+    fn push(&mut self, frame: SensorFrame, arrival: f64) -> std::result::Result<(), Refusal> {
         let period = self.period;
-        if let Some(next) = self.next_instant {
-            if frame.timestamp < next - 2.0 * period {
-                return Err("late");
+        if let Some(next) = self.next_index {
+            if frame.timestamp < self.instant(next) - 2.0 * period {
+                return Err(Refusal::Late);
             }
         }
+        let capacity = self.capacity;
         let s = self.sensors.entry(frame.sensor).or_default();
-        if !s.seen.insert(frame.seq) {
-            return Err("duplicate");
+        if s.seen.contains(&frame.seq) {
+            return Err(Refusal::Duplicate);
         }
-        s.latest = s.latest.max(frame.timestamp);
-        let at = s.frames.partition_point(|f| f.timestamp <= frame.timestamp);
-        s.frames.insert(at, frame.clone());
-        if self.next_instant.is_none() {
-            self.next_instant = Some((frame.timestamp / period).ceil() * period);
+        if s.frames.len() >= capacity {
+            return Err(Refusal::Overflow);
         }
-        self.pending.push_back((frame.timestamp, arrival));
+        s.seen.insert(frame.seq);
+        let timestamp = frame.timestamp;
+        s.latest = if s.frames.is_empty() {
+            timestamp
+        } else {
+            s.latest.max(timestamp)
+        };
+        let at = s.frames.partition_point(|f| f.timestamp <= timestamp);
+        s.frames.insert(at, frame);
+        if self.next_index.is_none() {
+            self.next_index = Some((timestamp / period).ceil() as i64);
+        }
+        self.pending.push_back((timestamp, arrival));
         Ok(())
     }
 
     /// The next instant if it is ready to fuse.
     fn ready(&self, flush: bool) -> Option<f64> {
-        let t = self.next_instant?;
+        let t = self.instant(self.next_index?);
         let newest = self
             .sensors
             .values()
@@ -192,8 +336,7 @@ impl Timeline {
             .iter()
             .filter_map(|(&sensor, s)| {
                 let pose = calibration.get(sensor)?;
-                let frames: &[SensorFrame] = &s.frames.iter().cloned().collect::<Vec<_>>();
-                let joints = sample_stream(frames, t, self.period)?;
+                let joints = sample_stream(&s.frames, t, self.period)?;
                 Some(SensorView {
                     sensor,
                     origin: pose.translation,
@@ -206,24 +349,359 @@ impl Timeline {
             .collect()
     }
 
-    /// Drops frames too old to matter for instants from `t` on.
-    fn forget_before(&mut self, t: f64) {
-        let keep_from = t - 3.0 * self.period;
+    /// Moves on to the next instant and drops the frames too old to matter
+    /// for it.
+    fn advance(&mut self) {
+        let Some(index) = self.next_index.map(|i| i + 1) else {
+            return;
+        };
+        self.next_index = Some(index);
+        let keep_from = self.instant(index) - 3.0 * self.period;
         for s in self.sensors.values_mut() {
-            while s.frames.len() > 1 && s.frames[1].timestamp < keep_from {
-                if let Some(f) = s.frames.pop_front() {
-                    s.seen.remove(&f.seq);
-                }
+            let old = s
+                .frames
+                .iter()
+                .skip(1)
+                .take_while(|f| f.timestamp < keep_from)
+                .count();
+            for f in s.frames.drain(..old) {
+                s.seen.remove(&f.seq);
             }
         }
     }
 }
 
-fn percentile_ms(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
+/// The sensors' clock as the server reckons it: `offset` is the lowest
+/// `t - s` (sensor time minus server seconds at arrival) of the accepted
+/// datagrams, that of the one that took longest to come; `None` until two
+/// datagrams agree on it.
+#[derive(Default)]
+struct Clock {
+    offset: Option<f64>,
+    /// Datagrams waiting for the clock to be set.
+    held: VecDeque<Held>,
+}
+
+/// A decoded, calibrated, screened datagram.
+struct Held {
+    frame: SensorFrame,
+    arrival: f64,
+    from: SocketAddr,
+    outliers: usize,
+}
+
+impl Held {
+    fn offset(&self) -> f64 {
+        self.frame.timestamp - self.arrival
     }
-    sorted[((sorted.len() - 1) as f64 * q).round() as usize] * 1000.0
+}
+
+/// Latencies in bins 1% wide on a log scale, from a microsecond to about
+/// twenty minutes: the median and the 99th percentile to within 1%, in the
+/// same memory however long the server runs.
+#[derive(Default)]
+struct Latencies {
+    counts: Vec<u64>,
+    total: u64,
+    max: f64,
+}
+
+impl Latencies {
+    const LEAST: f64 = 1e-6;
+    const RATIO: f64 = 1.01;
+    const BINS: usize = 2100;
+
+    fn add(&mut self, seconds: f64) {
+        if self.counts.is_empty() {
+            self.counts = vec![0; Self::BINS];
+        }
+        let bin = if seconds > Self::LEAST {
+            ((seconds / Self::LEAST).ln() / Self::RATIO.ln()) as usize
+        } else {
+            0
+        };
+        self.counts[bin.min(Self::BINS - 1)] += 1;
+        self.total += 1;
+        self.max = self.max.max(seconds);
+    }
+
+    /// The `q` quantile in milliseconds (the middle of its bin).
+    fn quantile_ms(&self, q: f64) -> f64 {
+        if self.total == 0 {
+            return 0.0;
+        }
+        let rank = ((self.total - 1) as f64 * q).round() as u64;
+        let mut below = 0;
+        for (bin, &count) in self.counts.iter().enumerate() {
+            below += count;
+            if below > rank {
+                let middle = Self::LEAST * Self::RATIO.powf(bin as f64 + 0.5);
+                return middle.min(self.max) * 1000.0;
+            }
+        }
+        self.max * 1000.0
+    }
+}
+
+/// The server without its socket: judges each datagram, keeps the
+/// timeline, fuses and writes. [`serve`] drives it from its socket and the
+/// wall clock (`now`: seconds since the server started); tests and the fuzz
+/// target drive it directly.
+#[doc(hidden)]
+pub struct ServerCore {
+    calibration: Calibration,
+    fps: f64,
+    max_skew: f64,
+    timeline: Timeline,
+    clock: Clock,
+    fuser: Fuser,
+    report: ServeReport,
+    latencies: Latencies,
+    sensors_seen: BTreeSet<u16>,
+    last_drain: Option<f64>,
+    /// Instants a drain may fuse beyond what the time since the last one
+    /// allows.
+    burst: u64,
+    log: bool,
+}
+
+impl ServerCore {
+    /// A server with the options' calibration, body and fusion, which
+    /// prints the first few problems of each kind on standard error.
+    pub fn new(options: &ServeOptions) -> Result<ServerCore> {
+        options.check()?;
+        Ok(ServerCore {
+            calibration: options.calibration.clone(),
+            fps: options.fps,
+            max_skew: options.max_skew,
+            timeline: Timeline::new(options),
+            clock: Clock::default(),
+            fuser: Fuser::new(options.fusion.online(), options.body.clone()),
+            report: ServeReport::default(),
+            latencies: Latencies::default(),
+            sensors_seen: BTreeSet::new(),
+            last_drain: None,
+            burst: (options.fps * (options.max_skew + 1.0)).ceil() as u64 + 2,
+            log: true,
+        })
+    }
+
+    /// Prints nothing.
+    pub fn quiet(mut self) -> ServerCore {
+        self.log = false;
+        self
+    }
+
+    fn log(&self, count: u64, message: std::fmt::Arguments) {
+        if self.log && count <= LOGGED_PER_KIND {
+            eprintln!("fuse serve: {message}");
+        }
+    }
+
+    /// One datagram from `from`, arrived at `now` (server seconds).
+    pub fn receive(&mut self, bytes: &[u8], from: SocketAddr, now: f64) {
+        self.report.datagrams += 1;
+        let mut frame = match decode_datagram(bytes) {
+            Ok(frame) => frame,
+            Err(why) => {
+                self.report.malformed += 1;
+                self.log(
+                    self.report.malformed,
+                    format_args!(
+                        "malformed datagram from {from} ({} bytes): {}; dropped",
+                        bytes.len(),
+                        printable(&why)
+                    ),
+                );
+                return;
+            }
+        };
+        if self.calibration.get(frame.sensor).is_none() {
+            self.report.uncalibrated += 1;
+            self.log(
+                self.report.uncalibrated,
+                format_args!(
+                    "datagram from {from}: sensor {} is not in the calibration; ignored",
+                    frame.sensor
+                ),
+            );
+            return;
+        }
+        self.sensors_seen.insert(frame.sensor);
+        if !(frame.timestamp.is_finite() && frame.timestamp.abs() <= MAX_TIMESTAMP) {
+            let t = frame.timestamp;
+            self.implausible_time(
+                from,
+                format_args!("time {t} s is beyond the {MAX_TIMESTAMP:e} s a clock may read"),
+            );
+            return;
+        }
+        let outliers = frame.screen_implausible_joints();
+        if outliers == JOINT_COUNT {
+            self.report.implausible_frames += 1;
+            self.log(
+                self.report.implausible_frames,
+                format_args!(
+                    "datagram from {from}: sensor {} frame {}: every joint is more than {} m from the sensor; dropped",
+                    frame.sensor,
+                    frame.seq,
+                    crate::recording::MAX_JOINT_DISTANCE
+                ),
+            );
+            return;
+        }
+        let held = Held {
+            frame,
+            arrival: now,
+            from,
+            outliers,
+        };
+        if self.clock.offset.is_some() {
+            self.judge(held);
+        } else {
+            self.hold(held);
+        }
+    }
+
+    fn implausible_time(&mut self, from: SocketAddr, why: std::fmt::Arguments) {
+        self.report.implausible_time += 1;
+        self.log(
+            self.report.implausible_time,
+            format_args!("datagram from {from}: implausible time: {why}; dropped"),
+        );
+    }
+
+    /// Before the clock is set: keeps the datagram until another one
+    /// agrees with it, then sets the clock and judges those held.
+    fn hold(&mut self, held: Held) {
+        let agrees = |h: &Held| {
+            (h.offset() - held.offset()).abs() <= self.max_skew
+                && (h.frame.sensor, h.frame.seq) != (held.frame.sensor, held.frame.seq)
+        };
+        if let Some(other) = self.clock.held.iter().find(|h| agrees(h)) {
+            self.clock.offset = Some(other.offset().min(held.offset()));
+            let mut waiting = std::mem::take(&mut self.clock.held);
+            waiting.push_back(held);
+            for h in waiting {
+                self.judge(h);
+            }
+            return;
+        }
+        if self.clock.held.len() >= HELD_BEFORE_CLOCK {
+            if let Some(old) = self.clock.held.pop_front() {
+                self.implausible_time(
+                    old.from,
+                    format_args!(
+                        "time {} s of sensor {} frame {}: no other datagram agreed with it",
+                        old.frame.timestamp, old.frame.sensor, old.frame.seq
+                    ),
+                );
+            }
+        }
+        self.clock.held.push_back(held);
+    }
+
+    /// Once the clock is set: drops a datagram whose time is more than
+    /// `max_skew` ahead of or behind the clock, gives the others to the
+    /// timeline.
+    fn judge(&mut self, held: Held) {
+        let Some(offset) = self.clock.offset else {
+            return;
+        };
+        let lead = held.offset() - offset;
+        let max_skew = self.max_skew;
+        if lead.abs() > max_skew {
+            let t = held.frame.timestamp;
+            let (sensor, seq) = (held.frame.sensor, held.frame.seq);
+            self.implausible_time(
+                held.from,
+                format_args!(
+                    "sensor {sensor} frame {seq} at {t} s is {:.3} s {} the sensors' clock as the server reckons it (more than the {} s allowed)",
+                    lead.abs(),
+                    if lead > 0.0 { "ahead of" } else { "behind" },
+                    max_skew
+                ),
+            );
+            return;
+        }
+        let offset_here = held.offset();
+        match self.timeline.push(held.frame, held.arrival) {
+            Ok(()) => {
+                self.report.frames_accepted += 1;
+                self.report.implausible_joints += held.outliers as u64;
+                self.clock.offset = Some(offset.min(offset_here));
+            }
+            Err(Refusal::Duplicate) => self.report.duplicates += 1,
+            Err(Refusal::Late) => self.report.late += 1,
+            Err(Refusal::Overflow) => {
+                self.report.overflow += 1;
+                self.log(
+                    self.report.overflow,
+                    format_args!(
+                        "datagram from {}: more frames than a sensor can send; dropped",
+                        held.from
+                    ),
+                );
+            }
+        }
+    }
+
+    /// Fuses the instants that are ready at `now` (server seconds), all of
+    /// them when `flush` (the server stops), into `sink`. Never fuses an
+    /// instant later than the sensors' clock now plus `max_skew`, nor more
+    /// instants than the time since the last drain allows plus a burst of
+    /// `max_skew` (and a second) worth.
+    pub fn drain(&mut self, now: f64, flush: bool, sink: &mut dyn FrameSink) -> Result<()> {
+        let Some(offset) = self.clock.offset else {
+            return Ok(());
+        };
+        let period = 1.0 / self.fps;
+        let fence = now + offset + self.max_skew + period;
+        let since = self.last_drain.map_or(0.0, |last| (now - last).max(0.0));
+        self.last_drain = Some(now);
+        let mut budget = ((since * self.fps).ceil() as u64).saturating_add(self.burst);
+        let started = Instant::now();
+        while budget > 0 {
+            let Some(t) = self.timeline.ready(flush) else {
+                break;
+            };
+            if t > fence {
+                break;
+            }
+            budget -= 1;
+            let fusing = Instant::now();
+            let views = self.timeline.views(t, &self.calibration);
+            let fused = self.fuser.fuse(t, &views);
+            self.report.fusion_seconds += fusing.elapsed().as_secs_f64();
+            if let Some(f) = fused {
+                sink.write(&f)?;
+                self.report.fused_frames += 1;
+                self.report.observations += (views.len() * JOINT_COUNT) as u64;
+            }
+            let written = now + started.elapsed().as_secs_f64();
+            while let Some(&(timestamp, arrival)) = self.timeline.pending.front() {
+                if timestamp > t + 1e-9 {
+                    break;
+                }
+                self.timeline.pending.pop_front();
+                self.latencies.add((written - arrival).max(0.0));
+            }
+            self.timeline.advance();
+        }
+        Ok(())
+    }
+
+    /// What the server saw and did; datagrams still waiting for the clock
+    /// count as implausible.
+    pub fn finish(mut self) -> ServeReport {
+        self.report.implausible_time += self.clock.held.len() as u64;
+        let mut report = self.report;
+        report.latency_median_ms = self.latencies.quantile_ms(0.5);
+        report.latency_p99_ms = self.latencies.quantile_ms(0.99);
+        report.latency_max_ms = self.latencies.max * 1000.0;
+        report.sensors_seen = self.sensors_seen.into_iter().collect();
+        report
+    }
 }
 
 /// Runs the fusion server until `shutdown` completes or `options.duration`
@@ -234,6 +712,7 @@ pub async fn serve(
     shutdown: impl std::future::Future<Output = ()>,
     bound: Option<tokio::sync::oneshot::Sender<SocketAddr>>,
 ) -> Result<ServeReport> {
+    let mut core = ServerCore::new(&options)?;
     let socket = UdpSocket::bind(options.listen)
         .await
         .map_err(|e| Error::Invalid(format!("cannot listen on {}: {e}", options.listen)))?;
@@ -244,16 +723,14 @@ pub async fn serve(
                 .map_err(|e| Error::Invalid(e.to_string()))?,
         );
     }
-    let mut fuser = Fuser::new(options.fusion.online(), options.body.clone());
-    let mut timeline = Timeline::new(options.fps, options.wait, options.sensor_timeout);
-    let mut report = ServeReport::default();
-    let mut latencies: Vec<f64> = Vec::new();
-    let mut sensors_seen = HashSet::new();
+    let started = Instant::now();
+    let now = || started.elapsed().as_secs_f64();
     let mut buf = vec![0u8; 65536];
     let deadline = options.duration.map(|d| tokio::time::Instant::now() + d);
     tokio::pin!(shutdown);
     let mut tick = tokio::time::interval(Duration::from_millis(20));
     let mut last_datagram: Option<Instant> = None;
+    let mut receive_errors = 0u64;
     loop {
         let idle = match (options.idle_exit, last_datagram) {
             (Some(limit), Some(last)) => last.elapsed() >= limit,
@@ -270,96 +747,26 @@ pub async fn serve(
                 } => true,
                 _ = tick.tick() => false,
                 received = socket.recv_from(&mut buf) => {
-                    let arrival = Instant::now();
-                    last_datagram = Some(arrival);
+                    last_datagram = Some(Instant::now());
                     match received {
-                        Ok((len, from)) => {
-                            report.datagrams += 1;
-                            match decode_datagram(&buf[..len]) {
-                                Ok(frame) => {
-                                    if options.calibration.get(frame.sensor).is_none() {
-                                        report.uncalibrated += 1;
-                                        if report.uncalibrated <= 5 {
-                                            eprintln!("fuse serve: datagram from {from}: sensor {} is not in the calibration; ignored", frame.sensor);
-                                        }
-                                    } else {
-                                        sensors_seen.insert(frame.sensor);
-                                        match timeline.push(frame, arrival) {
-                                            Ok(()) => report.frames_accepted += 1,
-                                            Err("duplicate") => report.duplicates += 1,
-                                            Err(_) => report.late += 1,
-                                        }
-                                    }
-                                }
-                                Err(why) => {
-                                    report.malformed += 1;
-                                    if report.malformed <= 5 {
-                                        eprintln!("fuse serve: malformed datagram from {from} ({len} bytes): {why}");
-                                    }
-                                }
+                        Ok((len, from)) => core.receive(&buf[..len], from, now()),
+                        Err(e) => {
+                            receive_errors += 1;
+                            if receive_errors <= LOGGED_PER_KIND {
+                                eprintln!("fuse serve: receive error: {e}");
                             }
                         }
-                        Err(e) => eprintln!("fuse serve: receive error: {e}"),
                     }
                     false
                 }
             };
-        drain(
-            &mut timeline,
-            &mut fuser,
-            &options,
-            sink,
-            &mut report,
-            &mut latencies,
-            stop,
-        )?;
+        core.drain(now(), stop, sink)?;
         if stop {
             break;
         }
     }
     sink.finish()?;
-    latencies.sort_by(f64::total_cmp);
-    report.latency_median_ms = percentile_ms(&latencies, 0.5);
-    report.latency_p99_ms = percentile_ms(&latencies, 0.99);
-    report.latency_max_ms = latencies.last().copied().unwrap_or(0.0) * 1000.0;
-    let mut seen: Vec<u16> = sensors_seen.into_iter().collect();
-    seen.sort();
-    report.sensors_seen = seen;
-    Ok(report)
-}
-
-fn drain(
-    timeline: &mut Timeline,
-    fuser: &mut Fuser,
-    options: &ServeOptions,
-    sink: &mut dyn FrameSink,
-    report: &mut ServeReport,
-    latencies: &mut Vec<f64>,
-    flush: bool,
-) -> Result<()> {
-    while let Some(t) = timeline.ready(flush) {
-        let started = Instant::now();
-        let views = timeline.views(t, &options.calibration);
-        let fused = fuser.fuse(t, &views);
-        report.fusion_seconds += started.elapsed().as_secs_f64();
-        if let Some(f) = fused {
-            sink.write(&f)?;
-            report.fused_frames += 1;
-            report.observations += (views.len() * crate::kinect::JOINT_COUNT) as u64;
-        }
-        let written = Instant::now();
-        while timeline
-            .pending
-            .front()
-            .is_some_and(|(ts, _)| *ts <= t + 1e-9)
-        {
-            let (_, arrival) = timeline.pending.pop_front().unwrap();
-            latencies.push((written - arrival).as_secs_f64());
-        }
-        timeline.next_instant = Some(t + timeline.period);
-        timeline.forget_before(t + timeline.period);
-    }
-    Ok(())
+    Ok(core.finish())
 }
 
 /// Options of the sender.
@@ -480,6 +887,8 @@ pub struct ServeFilesOptions {
     pub fps: f64,
     pub wait: f64,
     pub sensor_timeout: f64,
+    /// [`ServeOptions::max_skew`].
+    pub max_skew: f64,
     pub duration: Option<Duration>,
     pub idle_exit: Option<Duration>,
 }
@@ -499,18 +908,20 @@ pub fn serve_files(
 ) -> Result<ServeFilesReport> {
     let calibration = Calibration::read(&options.calibration)?;
     let body = BodyModel::read(&options.body)?;
-    let mut outputs = FusedOutputs::open(&options.outputs, body.clone(), options.fps)?;
     let server_options = ServeOptions {
         listen: options.listen,
         calibration,
-        body,
+        body: body.clone(),
         fusion: options.fusion,
         fps: options.fps,
         wait: options.wait,
         sensor_timeout: options.sensor_timeout,
+        max_skew: options.max_skew,
         duration: options.duration,
         idle_exit: options.idle_exit,
     };
+    server_options.check()?;
+    let mut outputs = FusedOutputs::open(&options.outputs, body, options.fps)?;
     let server = serve_blocking_with(server_options, &mut outputs, on_listening)?;
     Ok(ServeFilesReport {
         server,
@@ -587,6 +998,7 @@ mod tests {
                 fps: 30.0,
                 wait: 0.1,
                 sensor_timeout: 0.5,
+                max_skew: DEFAULT_MAX_SKEW,
                 duration: Some(Duration::from_millis(3000)),
                 idle_exit: Some(Duration::from_millis(400)),
             };
@@ -640,5 +1052,216 @@ mod tests {
             );
             assert_eq!(f.joints.len(), JOINT_COUNT);
         });
+    }
+
+    /// Three calibrated sensors (0, 1, 2) at the origin, 30 fps.
+    fn core_options() -> ServeOptions {
+        let mut calibration = Calibration::default();
+        for id in 0..3 {
+            calibration.set(SensorPose {
+                id,
+                transform: RigidTransform::IDENTITY,
+                method: None,
+                rms_residual: None,
+                pairs: None,
+            });
+        }
+        let pose = crate::body::tests::standing_pose();
+        ServeOptions {
+            listen: "127.0.0.1:0".parse().unwrap(),
+            calibration,
+            body: BodyModel::from_positions([&pose; 20], MeasureOptions::default()),
+            fusion: FusionOptions::best(),
+            fps: 30.0,
+            wait: 0.1,
+            sensor_timeout: 0.5,
+            max_skew: DEFAULT_MAX_SKEW,
+            duration: None,
+            idle_exit: None,
+        }
+    }
+
+    /// A take of `frames` frames of sensors 0 and 1, each arriving 10 ms
+    /// after its time (server seconds = sensor seconds), in arrival order.
+    fn take(frames: u64) -> Vec<(f64, Vec<u8>)> {
+        let mut out = Vec::new();
+        for seq in 0..frames {
+            for sensor in 0..2 {
+                let f = frame(sensor, seq);
+                out.push((
+                    f.timestamp + 0.01 + sensor as f64 * 1e-4,
+                    encode_datagram(&f),
+                ));
+            }
+        }
+        out
+    }
+
+    /// Feeds datagrams to a server core as the socket loop does (a drain
+    /// after each), then stops it. Returns the report, the fused frames and
+    /// the most frames one drain wrote.
+    fn run_core(
+        options: &ServeOptions,
+        datagrams: &[(f64, Vec<u8>)],
+    ) -> (ServeReport, Vec<crate::fusion::FusedFrame>, usize) {
+        let mut core = ServerCore::new(options).unwrap().quiet();
+        let mut sink = MemorySink::default();
+        let from: SocketAddr = "127.0.0.1:9".parse().unwrap();
+        let mut most = 0;
+        let mut now = 0.0;
+        for (arrival, bytes) in datagrams {
+            now = *arrival;
+            core.receive(bytes, from, now);
+            let before = sink.frames.len();
+            core.drain(now, false, &mut sink).unwrap();
+            most = most.max(sink.frames.len() - before);
+        }
+        core.drain(now + 1.0, true, &mut sink).unwrap();
+        let report = core.finish();
+        (report, sink.frames, most)
+    }
+
+    fn accounted(r: &ServeReport) -> u64 {
+        r.malformed
+            + r.uncalibrated
+            + r.implausible_time
+            + r.implausible_frames
+            + r.duplicates
+            + r.late
+            + r.overflow
+            + r.frames_accepted
+    }
+
+    fn same_frames(a: &[crate::fusion::FusedFrame], b: &[crate::fusion::FusedFrame]) {
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(b) {
+            assert_eq!(x.time, y.time);
+            for (p, q) in x.joints.iter().zip(&y.joints) {
+                assert!((*p - *q).length() < 1e-6, "{p} vs {q} at {}", x.time);
+            }
+        }
+    }
+
+    #[test]
+    fn a_wrong_first_time_sets_no_clock() {
+        let options = core_options();
+        let clean = take(90);
+        let (report, expected, _) = run_core(&options, &clean);
+        assert_eq!(report.implausible_time, 0, "{report:?}");
+        assert!(expected.len() >= 89, "{}", expected.len());
+        for t in [1e30, -1e30, 1e4, -5e3, 60.0] {
+            let mut bogus = frame(0, 999);
+            bogus.timestamp = t;
+            let mut datagrams = vec![(0.0, encode_datagram(&bogus))];
+            datagrams.extend(clean.iter().cloned());
+            let (report, fused, most) = run_core(&options, &datagrams);
+            assert_eq!(report.implausible_time, 1, "t = {t}: {report:?}");
+            assert_eq!(accounted(&report), report.datagrams, "{report:?}");
+            same_frames(&fused, &expected);
+            assert!(most <= 3, "t = {t}: {most} frames from one datagram");
+        }
+    }
+
+    #[test]
+    fn a_wrong_time_mid_stream_is_dropped() {
+        let options = core_options();
+        let clean = take(90);
+        let (_, expected, _) = run_core(&options, &clean);
+        for t in [1e30, 1e4, -1e4, 1.5 + 2.0 * DEFAULT_MAX_SKEW, -1e30] {
+            let mut bogus = frame(1, 5000);
+            bogus.timestamp = t;
+            let mut datagrams = clean.clone();
+            datagrams.insert(90, (1.5, encode_datagram(&bogus)));
+            let (report, fused, most) = run_core(&options, &datagrams);
+            assert_eq!(report.implausible_time, 1, "t = {t}: {report:?}");
+            assert_eq!(accounted(&report), report.datagrams, "{report:?}");
+            same_frames(&fused, &expected);
+            assert!(most <= 3, "t = {t}: {most} frames from one datagram");
+        }
+    }
+
+    #[test]
+    fn absurd_joints_never_move_the_fused_skeleton() {
+        let options = core_options();
+        let clean = take(90);
+        let (_, expected, _) = run_core(&options, &clean);
+        // A frame of sensor 0 at a real instant with every joint at 1e30 m,
+        // Tracked; then one with only its head there.
+        let mut far = frame(0, 6000);
+        far.timestamp = 45.0 / 30.0;
+        for j in far.joints.iter_mut() {
+            j.position = Vec3::splat(1e30);
+        }
+        let mut head = frame(0, 6001);
+        head.timestamp = 60.0 / 30.0;
+        head.joints[crate::kinect::joint::HEAD].position = Vec3::new(0.0, 1e30, 0.0);
+        let mut datagrams = clean.clone();
+        datagrams.insert(91, (45.0 / 30.0 + 0.01, encode_datagram(&far)));
+        datagrams.insert(121, (2.0 + 0.01, encode_datagram(&head)));
+        let (report, fused, _) = run_core(&options, &datagrams);
+        assert_eq!(report.implausible_frames, 1, "{report:?}");
+        assert_eq!(report.implausible_joints, 1, "{report:?}");
+        assert_eq!(accounted(&report), report.datagrams, "{report:?}");
+        assert_eq!(fused.len(), expected.len());
+        for (f, e) in fused.iter().zip(&expected) {
+            for (p, q) in f.joints.iter().zip(&e.joints) {
+                // The head frame is a third observation of sensor 0 at its
+                // instant: its other joints count, the head does not.
+                assert!((*p - *q).length() < 0.05, "{p} vs {q} at {}", f.time);
+            }
+        }
+    }
+
+    #[test]
+    fn a_flood_ahead_of_the_clock_is_bounded() {
+        // A minute of frames sent within a tenth of a second: the server
+        // takes what is within max_skew of its clock and never fuses more
+        // than the time allows.
+        let options = core_options();
+        let datagrams: Vec<(f64, Vec<u8>)> = take(1800)
+            .into_iter()
+            .enumerate()
+            .map(|(i, (_, bytes))| (i as f64 * 0.1 / 3600.0, bytes))
+            .collect();
+        let (report, fused, most) = run_core(&options, &datagrams);
+        assert_eq!(accounted(&report), report.datagrams, "{report:?}");
+        let allowed = ((0.1 + 1.0 + DEFAULT_MAX_SKEW + 1.0) * 30.0) as usize;
+        assert!(fused.len() <= allowed, "{} > {allowed}", fused.len());
+        assert!(fused.len() >= 280, "{}", fused.len());
+        assert!(report.implausible_time > 2900, "{report:?}");
+        assert!(most as u64 <= (30.0 * (DEFAULT_MAX_SKEW + 1.0)) as u64 + 3);
+    }
+
+    #[test]
+    fn options_out_of_range_are_refused() {
+        let changes: [fn(&mut ServeOptions); 7] = [
+            |o: &mut ServeOptions| o.fps = 0.0,
+            |o: &mut ServeOptions| o.fps = 1e9,
+            |o: &mut ServeOptions| o.fps = f64::NAN,
+            |o: &mut ServeOptions| o.wait = -1.0,
+            |o: &mut ServeOptions| o.sensor_timeout = f64::INFINITY,
+            |o: &mut ServeOptions| o.max_skew = 1e30,
+            |o: &mut ServeOptions| o.max_skew = 0.0,
+        ];
+        for change in changes {
+            let mut options = core_options();
+            change(&mut options);
+            assert!(ServerCore::new(&options).is_err(), "{options:?}");
+        }
+    }
+
+    #[test]
+    fn latency_quantiles_are_within_a_percent() {
+        let mut l = Latencies::default();
+        let values: Vec<f64> = (1..=1000).map(|i| i as f64 * 1e-4).collect();
+        for v in &values {
+            l.add(*v);
+        }
+        let exact = |q: f64| values[((values.len() - 1) as f64 * q).round() as usize] * 1000.0;
+        for q in [0.5, 0.99] {
+            let (a, b) = (l.quantile_ms(q), exact(q));
+            assert!((a - b).abs() <= 0.011 * b, "{a} vs {b}");
+        }
+        assert_eq!(l.max, 0.1);
     }
 }

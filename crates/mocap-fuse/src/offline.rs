@@ -21,6 +21,11 @@ use crate::kinect::JOINT_COUNT;
 use crate::output::{FrameSink, FusedOutputs, OutputFiles, OutputReport};
 use crate::recording::{read_recordings, JointObservation, SensorFrame};
 
+/// The most instants one fusion may have: as many as the channel values a
+/// motion may hold allow for the 25 joints' positions
+/// ([`mocap_core::MAX_VALUES`]), 33 hours at 30 frames per second.
+pub const MAX_FUSED_FRAMES: usize = mocap_core::MAX_VALUES / (3 * JOINT_COUNT);
+
 /// Each sensor's frames in time order (duplicates removed).
 #[derive(Debug, Clone, Default)]
 pub struct SensorStreams {
@@ -28,9 +33,16 @@ pub struct SensorStreams {
 }
 
 impl SensorStreams {
+    /// Sorts the frames into streams. Every frame is screened for outliers
+    /// first ([`SensorFrame::screen_implausible_joints`], as the fusion
+    /// server does): joints beyond [`crate::MAX_JOINT_DISTANCE`] from their
+    /// sensor are NotTracked, and a frame with no plausible joint is dropped.
     pub fn new(frames: impl IntoIterator<Item = SensorFrame>) -> SensorStreams {
         let mut streams: BTreeMap<u16, Vec<SensorFrame>> = BTreeMap::new();
-        for f in frames {
+        for mut f in frames {
+            if f.screen_implausible_joints() == JOINT_COUNT {
+                continue;
+            }
             streams.entry(f.sensor).or_default().push(f);
         }
         for s in streams.values_mut() {
@@ -55,6 +67,38 @@ impl SensorStreams {
             .map(|f| f.timestamp)
             .max_by(f64::total_cmp)?;
         Some((first, last))
+    }
+}
+
+impl SensorStreams {
+    /// Checks that fusing the streams at `fps` from their first to their
+    /// last timestamp makes at most [`MAX_FUSED_FRAMES`] instants: a
+    /// timestamp far from the others (`t` = 1e30 on one line) would
+    /// otherwise ask for an endless take.
+    pub fn check_span(&self, fps: f64) -> Result<()> {
+        let Some((first, last)) = self.span() else {
+            return Ok(());
+        };
+        let instants = (last - first) * fps;
+        if instants.is_finite() && instants < MAX_FUSED_FRAMES as f64 {
+            return Ok(());
+        }
+        let at = |t: f64| {
+            self.streams
+                .values()
+                .flatten()
+                .find(|f| f.timestamp == t)
+                .map_or(String::new(), |f| {
+                    format!(" (sensor {} frame {})", f.sensor, f.seq)
+                })
+        };
+        Err(Error::Invalid(format!(
+            "the recordings' times run from {first} s{} to {last} s{}: at {fps} frames per second \
+             that is more than the {MAX_FUSED_FRAMES} fused frames a take may have; \
+             is a timestamp wrong?",
+            at(first),
+            at(last)
+        )))
     }
 }
 
@@ -135,7 +179,8 @@ pub fn check_calibrated(streams: &SensorStreams, calibration: &Calibration) -> R
 }
 
 /// Fuses recordings on a grid of `fps` instants from the first timestamp
-/// (or from `start` when given) to the last.
+/// (or from `start` when given) to the last, at most [`MAX_FUSED_FRAMES`]
+/// instants (check longer streams with [`SensorStreams::check_span`]).
 pub fn fuse_streams(
     streams: &SensorStreams,
     calibration: &Calibration,
@@ -148,7 +193,7 @@ pub fn fuse_streams(
     };
     let period = 1.0 / fps;
     let t0 = start.unwrap_or(first);
-    let count = ((last - t0) * fps).floor().max(-1.0) as i64 + 1;
+    let count = (((last - t0) * fps).floor().max(-1.0) as i64 + 1).min(MAX_FUSED_FRAMES as i64);
     let mut out = Vec::with_capacity(count.max(0) as usize);
     for i in 0..count {
         let t = t0 + i as f64 * period;
@@ -213,6 +258,7 @@ pub fn fuse_recordings(
         ));
     }
     check_calibrated(&streams, calibration)?;
+    streams.check_span(fps)?;
     // Instants on multiples of the period, as the server fuses them, so that
     // offline and live outputs (and ground truth) share their times.
     let start = streams.span().map(|(first, _)| (first * fps).ceil() / fps);
@@ -245,6 +291,9 @@ pub struct FuseFilesOptions {
 pub struct FuseFilesReport {
     pub fused_frames: usize,
     pub sensors: Vec<u16>,
+    /// Joints farther than [`crate::MAX_JOINT_DISTANCE`] from their sensor,
+    /// treated as NotTracked ([`SensorFrame::screen_implausible_joints`]).
+    pub implausible_joints: usize,
     pub body_measured_from_recordings: bool,
     pub outputs: Vec<OutputReport>,
 }
@@ -253,7 +302,13 @@ pub struct FuseFilesReport {
 /// person's body ([`fuse_recordings`]) into the output files.
 pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
     let calibration = Calibration::read(&options.calibration)?;
-    let frames = read_recordings(&options.recordings)?;
+    let mut frames = read_recordings(&options.recordings)?;
+    // Screened here, as the fusion would, so that the person is measured
+    // without the outliers too, and they are counted.
+    let implausible_joints = frames
+        .iter_mut()
+        .map(SensorFrame::screen_implausible_joints)
+        .sum();
     let mut sensors: Vec<u16> = frames.iter().map(|f| f.sensor).collect();
     sensors.sort();
     sensors.dedup();
@@ -267,6 +322,7 @@ pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
     Ok(FuseFilesReport {
         fused_frames: count,
         sensors,
+        implausible_joints,
         body_measured_from_recordings: options.body.is_none(),
         outputs: outputs.reports().to_vec(),
     })
@@ -319,5 +375,35 @@ mod tests {
         ]);
         let v = &s.streams[&0];
         assert_eq!(v.iter().map(|f| f.seq).collect::<Vec<_>>(), vec![0, 2]);
+    }
+
+    #[test]
+    fn outliers_are_screened_and_absurd_spans_refused() {
+        let p = 1.0 / 30.0;
+        let mut one_far = frame(1, p, 1.0, TrackingState::Tracked);
+        one_far.joints[3].position = Vec3::new(0.0, 20.0, 0.0);
+        let mut all_far = frame(2, 2.0 * p, 2.0, TrackingState::Tracked);
+        for j in all_far.joints.iter_mut() {
+            j.position = Vec3::splat(1e30);
+        }
+        let s = SensorStreams::new(vec![
+            frame(0, 0.0, 0.0, TrackingState::Tracked),
+            one_far,
+            all_far,
+        ]);
+        let v = &s.streams[&0];
+        assert_eq!(v.iter().map(|f| f.seq).collect::<Vec<_>>(), vec![0, 1]);
+        assert_eq!(v[1].joints[3].state, TrackingState::NotTracked);
+        assert_eq!(v[1].joints[3].position, Vec3::new(1.0, 0.0, 2.0));
+        s.check_span(30.0).unwrap();
+        let s = SensorStreams::new(vec![
+            frame(0, 0.0, 0.0, TrackingState::Tracked),
+            frame(7, 1e30, 0.0, TrackingState::Tracked),
+        ]);
+        let err = s.check_span(30.0).unwrap_err().to_string();
+        assert!(
+            err.contains("to 1000000000000000000000000000000 s (sensor 0 frame 7)"),
+            "{err}"
+        );
     }
 }

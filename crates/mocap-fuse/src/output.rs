@@ -26,7 +26,10 @@ pub trait FrameSink {
 }
 
 /// Fused frames as JSON lines (`{"t":..,"joints":[[x,y,z],..],"confidence":[..]}`),
-/// written to a temporary file that replaces the output on `finish`.
+/// written as they come to a temporary file beside the output (named as
+/// `mocap_core::io::atomic` names its own, `.NAME.PID.tmp`) that replaces
+/// the output on `finish`, and is removed when the sink is dropped
+/// unfinished (an error).
 pub struct JsonlSink {
     path: PathBuf,
     tmp: PathBuf,
@@ -35,7 +38,14 @@ pub struct JsonlSink {
 
 impl JsonlSink {
     pub fn create(path: PathBuf) -> Result<JsonlSink> {
-        let tmp = path.with_extension(format!("jsonl.{}.tmp", std::process::id()));
+        let name = path
+            .file_name()
+            .ok_or_else(|| Error::Invalid(format!("{}: not a file path", path.display())))?;
+        let tmp = path.with_file_name(format!(
+            ".{}.{}.tmp",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
         let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         Ok(JsonlSink {
             path,
@@ -78,15 +88,27 @@ impl FrameSink for JsonlSink {
 
     fn finish(&mut self) -> Result<()> {
         use std::io::Write;
-        if let Some(mut out) = self.out.take() {
-            out.flush().map_err(|e| Error::io(&self.tmp, e))?;
-            let file = out
-                .into_inner()
-                .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
-            file.sync_all().map_err(|e| Error::io(&self.tmp, e))?;
-            std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
+        let Some(mut out) = self.out.take() else {
+            return Ok(());
+        };
+        let result = (|| {
+            out.flush()?;
+            let file = out.into_inner().map_err(|e| e.into_error())?;
+            file.sync_all()?;
+            std::fs::rename(&self.tmp, &self.path)
+        })();
+        result.map_err(|e| {
+            let _ = std::fs::remove_file(&self.tmp);
+            Error::io(&self.path, e)
+        })
+    }
+}
+
+impl Drop for JsonlSink {
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
         }
-        Ok(())
     }
 }
 

@@ -52,6 +52,14 @@ impl JointObservation {
     };
 }
 
+/// The farthest a joint may be from the sensor that saw it, in metres.
+/// Kinect v2 tracks bodies 0.5 to 4.5 m away; ten metres leaves room for
+/// other depth sensors of its kind and for any calibration error, and
+/// nothing a sensor reports beyond it is part of the person it watches. A
+/// joint farther away (an absurd coordinate, such as 1e30 m) is an outlier,
+/// not an observation ([`SensorFrame::screen_implausible_joints`]).
+pub const MAX_JOINT_DISTANCE: f32 = 10.0;
+
 /// One skeleton frame of one sensor.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SensorFrame {
@@ -84,6 +92,42 @@ fn default_version() -> u32 {
 }
 
 impl SensorFrame {
+    /// Treats the joints farther than [`MAX_JOINT_DISTANCE`] from the sensor
+    /// (camera space, before calibration) as outliers: each becomes
+    /// NotTracked, so that it has no weight in the fusion, and is put at the
+    /// mean of the frame's plausible joints (at the sensor when there is
+    /// none), so that no guess, bone-length term or facing computed from
+    /// the frame's positions sees the absurd position. Returns how many
+    /// joints were outliers; all [`JOINT_COUNT`] means the frame holds no
+    /// observation at all. The fusion server and the offline fusion
+    /// ([`crate::offline::SensorStreams::new`]) both screen every frame so.
+    pub fn screen_implausible_joints(&mut self) -> usize {
+        let plausible = |j: &JointObservation| j.position.length() <= MAX_JOINT_DISTANCE;
+        let (sum, kept) = self
+            .joints
+            .iter()
+            .filter(|j| plausible(j))
+            .fold((Vec3::ZERO, 0usize), |(sum, n), j| {
+                (sum + j.position, n + 1)
+            });
+        let outliers = JOINT_COUNT - kept;
+        if outliers == 0 {
+            return 0;
+        }
+        let stand_in = if kept > 0 {
+            sum / kept as f32
+        } else {
+            Vec3::ZERO
+        };
+        for j in self.joints.iter_mut().filter(|j| !plausible(j)) {
+            *j = JointObservation {
+                position: stand_in,
+                state: TrackingState::NotTracked,
+            };
+        }
+        outliers
+    }
+
     /// The frame as one line of JSON (no newline). Written by hand rather
     /// than through serde: the server and the sender do this for every
     /// datagram, and positions rounded to 0.1 mm (more than any depth sensor
@@ -114,7 +158,27 @@ impl SensorFrame {
     /// Parses one frame from JSON, checking every field. The error message
     /// says what is wrong; the caller adds where.
     pub fn from_json(text: &str) -> std::result::Result<SensorFrame, String> {
-        let record: FrameRecord = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        SensorFrame::from_json_at(text).map_err(|(_, message)| message)
+    }
+
+    /// [`SensorFrame::from_json`], with the 1-based column of the problem
+    /// when the JSON itself is at fault (1 otherwise).
+    fn from_json_at(text: &str) -> std::result::Result<SensorFrame, (usize, String)> {
+        let record: FrameRecord = serde_json::from_str(text).map_err(|e| {
+            // serde_json says "... at line 1 column 17"; the column goes to
+            // the location, the rest is the message.
+            let column = e.column().max(1);
+            let message = e.to_string();
+            let message = match message.rfind(" at line ") {
+                Some(at) => message[..at].to_string(),
+                None => message,
+            };
+            (column, message)
+        })?;
+        SensorFrame::from_record(record).map_err(|message| (1, message))
+    }
+
+    fn from_record(record: FrameRecord) -> std::result::Result<SensorFrame, String> {
         if record.v != RECORDING_VERSION {
             return Err(format!(
                 "recording format version {} is not supported (this reader knows {RECORDING_VERSION})",
@@ -139,6 +203,13 @@ impl SensorFrame {
         for (n, [x, y, z, s]) in record.joints.into_iter().enumerate() {
             if !(x.is_finite() && y.is_finite() && z.is_finite()) {
                 return Err(format!("joint {n}: position is not finite"));
+            }
+            // Positions are kept as f32: a coordinate beyond its range
+            // (about 3.4e38) would become infinite.
+            if [x, y, z].iter().any(|c| c.abs() > f32::MAX as f64) {
+                return Err(format!(
+                    "joint {n}: position [{x}, {y}, {z}] is out of range"
+                ));
             }
             let state = if s.fract() == 0.0 {
                 TrackingState::from_code(s as i64)
@@ -180,11 +251,11 @@ pub fn read_recording(path: &Path) -> Result<Vec<SensorFrame>> {
         if line.trim().is_empty() {
             continue;
         }
-        let frame = SensorFrame::from_json(line).map_err(|message| {
+        let frame = SensorFrame::from_json_at(line).map_err(|(column, message)| {
             parse_error(
                 path,
                 i + 1,
-                1,
+                column,
                 format!("expected a sensor frame object: {message}"),
             )
         })?;
@@ -264,6 +335,11 @@ pub struct NtuBody {
 /// orientationY orientationZ trackingState`.
 pub fn read_ntu_skeleton(path: &Path) -> Result<Vec<Vec<NtuBody>>> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    read_ntu_skeleton_from(&text, path)
+}
+
+/// [`read_ntu_skeleton`] on the text of a file; `path` names it in errors.
+pub fn read_ntu_skeleton_from(text: &str, path: &Path) -> Result<Vec<Vec<NtuBody>>> {
     let mut lines = text
         .lines()
         .enumerate()
@@ -300,13 +376,16 @@ pub fn read_ntu_skeleton(path: &Path) -> Result<Vec<Vec<NtuBody>>> {
         }
     };
     let frame_count = count(next("the frame count")?, "the frame count")?;
-    let mut frames = Vec::with_capacity(frame_count);
+    // No room reserved from the counts: they are the file's word, and a
+    // frame or a body takes at least a line, so the file's length bounds
+    // what is really there.
+    let mut frames = Vec::new();
     for f in 0..frame_count {
         let body_count = count(
             next(&format!("the body count of frame {}", f + 1))?,
             "a body count",
         )?;
-        let mut bodies = Vec::with_capacity(body_count);
+        let mut bodies = Vec::new();
         for _ in 0..body_count {
             let (line, header) = next("a body line of 10 values")?;
             if header.len() != 10 {
@@ -360,7 +439,7 @@ pub fn read_ntu_skeleton(path: &Path) -> Result<Vec<Vec<NtuBody>>> {
                             parse_error(
                                 path,
                                 line,
-                                column_of_field(&text, line, k),
+                                column_of_field(text, line, k),
                                 format!(
                                     "expected a number for the joint coordinate, found {:?}",
                                     v[k]
@@ -376,7 +455,7 @@ pub fn read_ntu_skeleton(path: &Path) -> Result<Vec<Vec<NtuBody>>> {
                         parse_error(
                             path,
                             line,
-                            column_of_field(&text, line, 11),
+                            column_of_field(text, line, 11),
                             format!("expected a tracking state 0, 1 or 2, found {:?}", v[11]),
                         )
                     })?;
@@ -553,6 +632,12 @@ mod tests {
         let cases = [
             (good.replace("\"v\":1", "\"v\":7"), "version"),
             (good.replace(",2]", ",5]"), "tracking state"),
+            (good.replacen("[0.0000,", "[1e39,", 1), "out of range"),
+            (
+                good.replacen("[0.0000,", "[1e999,", 1),
+                "number out of range",
+            ),
+            (good.replacen("[0.0000,", "[NaN,", 1), "expected value"),
             ("{\"sensor\":1}".to_string(), "missing field"),
             ("not json".to_string(), "expected"),
             (
@@ -579,7 +664,11 @@ mod tests {
         )
         .unwrap();
         let err = read_recording(&path).unwrap_err().to_string();
-        assert!(err.contains("rec.jsonl:3:1"), "{err}");
+        // The column is where the JSON reader found the problem: the end
+        // of the object that lacks fields.
+        assert!(err.contains("rec.jsonl:3:13:"), "{err}");
+        assert!(err.contains("missing field `seq`"), "{err}");
+        assert!(!err.contains("at line"), "{err}");
     }
 
     fn ntu_text(frames: &[&[u64]]) -> String {

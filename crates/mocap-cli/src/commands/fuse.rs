@@ -417,6 +417,13 @@ fn run_offline(args: RunArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         "fused {} frames from sensors {:?} ({})",
         report.fused_frames, report.sensors, args.method
     );
+    if report.implausible_joints > 0 {
+        println!(
+            "{} joints farther than {} m from their sensor fused as NotTracked",
+            report.implausible_joints,
+            mocap_fuse::MAX_JOINT_DISTANCE
+        );
+    }
     print_outputs(&report.outputs);
     Ok(())
 }
@@ -446,6 +453,10 @@ struct ServeArgs {
     /// Seconds behind the newest frame after which a sensor counts as gone.
     #[arg(long, default_value_t = 0.5)]
     sensor_timeout: f64,
+    /// Seconds a datagram's time may be ahead of or behind the sensors' clock as the server
+    /// reckons it; others are dropped as implausible (raise it for replays much faster than real time).
+    #[arg(long, default_value_t = mocap_fuse::DEFAULT_MAX_SKEW)]
+    max_skew: f64,
     /// Fusion method.
     #[arg(long, default_value = "best", value_parser = clap::builder::PossibleValuesParser::new(METHOD_NAMES))]
     method: String,
@@ -484,6 +495,7 @@ fn serve(args: ServeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         fps: args.fps,
         wait: args.wait,
         sensor_timeout: args.sensor_timeout,
+        max_skew: args.max_skew,
         duration: seconds("duration", args.duration)?,
         idle_exit: seconds("idle-exit", args.idle_exit)?,
     };
@@ -501,6 +513,17 @@ fn serve(args: ServeArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         "{} datagrams: {} frames accepted, {} malformed, {} duplicates, {} late, {} from uncalibrated sensors; {} fused frames from sensors {:?}",
         s.datagrams, s.frames_accepted, s.malformed, s.duplicates, s.late, s.uncalibrated, s.fused_frames, s.sensors_seen
     );
+    if s.implausible_time + s.implausible_frames + s.implausible_joints + s.overflow > 0 {
+        println!(
+            "dropped {} datagrams with an implausible time, {} frames with no joint within {} m of the sensor, {} beyond what a sensor can send; {} joints beyond {} m fused as NotTracked",
+            s.implausible_time,
+            s.implausible_frames,
+            mocap_fuse::MAX_JOINT_DISTANCE,
+            s.overflow,
+            s.implausible_joints,
+            mocap_fuse::MAX_JOINT_DISTANCE
+        );
+    }
     println!(
         "latency from datagram to fused frame: median {:.1} ms, p99 {:.1} ms",
         s.latency_median_ms, s.latency_p99_ms
