@@ -9,6 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
+use mocap_core::io::atomic::AtomicFile;
 use mocap_core::{Error, Result};
 use serde::Serialize;
 
@@ -26,31 +27,17 @@ pub trait FrameSink {
 }
 
 /// Fused frames as JSON lines (`{"t":..,"joints":[[x,y,z],..],"confidence":[..]}`),
-/// written as they come to a temporary file beside the output (named as
-/// `mocap_core::io::atomic` names its own, `.NAME.PID.tmp`) that replaces
-/// the output on `finish`, and is removed when the sink is dropped
-/// unfinished (an error).
+/// written as they come through a [`AtomicFile`]: its temporary file replaces
+/// the output on `finish`, and is removed when the sink is dropped unfinished
+/// (an error) or the process is interrupted.
 pub struct JsonlSink {
-    path: PathBuf,
-    tmp: PathBuf,
-    out: Option<std::io::BufWriter<std::fs::File>>,
+    out: Option<AtomicFile>,
 }
 
 impl JsonlSink {
     pub fn create(path: PathBuf) -> Result<JsonlSink> {
-        let name = path
-            .file_name()
-            .ok_or_else(|| Error::Invalid(format!("{}: not a file path", path.display())))?;
-        let tmp = path.with_file_name(format!(
-            ".{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let file = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         Ok(JsonlSink {
-            path,
-            tmp,
-            out: Some(std::io::BufWriter::new(file)),
+            out: Some(AtomicFile::create(&path)?),
         })
     }
 }
@@ -81,33 +68,15 @@ impl FrameSink for JsonlSink {
     fn write(&mut self, frame: &FusedFrame) -> Result<()> {
         use std::io::Write;
         if let Some(out) = self.out.as_mut() {
-            writeln!(out, "{}", fused_frame_json(frame)).map_err(|e| Error::io(&self.tmp, e))?;
+            writeln!(out, "{}", fused_frame_json(frame)).map_err(|e| Error::io(out.path(), e))?;
         }
         Ok(())
     }
 
     fn finish(&mut self) -> Result<()> {
-        use std::io::Write;
-        let Some(mut out) = self.out.take() else {
-            return Ok(());
-        };
-        let result = (|| {
-            out.flush()?;
-            let file = out.into_inner().map_err(|e| e.into_error())?;
-            file.sync_all()?;
-            std::fs::rename(&self.tmp, &self.path)
-        })();
-        result.map_err(|e| {
-            let _ = std::fs::remove_file(&self.tmp);
-            Error::io(&self.path, e)
-        })
-    }
-}
-
-impl Drop for JsonlSink {
-    fn drop(&mut self) {
-        if self.out.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
+        match self.out.take() {
+            Some(out) => out.commit(),
+            None => Ok(()),
         }
     }
 }
