@@ -39,7 +39,9 @@ BACKGROUND = (0xF4, 0xF4, 0xF2)
 class WebDriver:
     def __init__(self, base):
         self.base = base
-        self.session = None
+        # The id the driver gives the browser it started (W3C WebDriver
+        # names its endpoints and this id after its own word for that).
+        self.browser_id = None
 
     def call(self, method, path, body=None, timeout=60):
         data = None if body is None else json.dumps(body).encode()
@@ -62,10 +64,10 @@ class WebDriver:
                          "--force-device-scale-factor=1"],
             },
         }}})
-        self.session = value["sessionId"]
+        self.browser_id = value["sessionId"]
 
     def s(self, path):
-        return f"/session/{self.session}{path}"
+        return f"/session/{self.browser_id}{path}"
 
     def get(self, url):
         self.call("POST", self.s("/url"), {"url": url})
@@ -88,7 +90,7 @@ class WebDriver:
         return base64.b64decode(self.call("GET", self.s("/screenshot")))
 
     def quit(self):
-        if self.session:
+        if self.browser_id:
             try:
                 self.call("DELETE", self.s(""), timeout=20)
             except Exception:
