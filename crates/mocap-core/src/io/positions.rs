@@ -7,37 +7,34 @@
 
 use std::io::Write;
 
-use crate::kinematics::GlobalPoses;
+use crate::kinematics::{forward_kinematics_range, frame_pieces};
 use crate::motion::Motion;
 
-/// Writes the positions of every frame as CSV.
-pub fn write_positions_csv(
-    out: &mut dyn Write,
-    motion: &Motion,
-    poses: &GlobalPoses,
-) -> std::io::Result<()> {
+/// Writes the positions of every frame as CSV (computed a piece of the take
+/// at a time: memory does not grow with the take).
+pub fn write_positions_csv(out: &mut dyn Write, motion: &Motion) -> std::io::Result<()> {
     write!(out, "frame,time")?;
     for joint in motion.skeleton().joints() {
         let name = csv_field(&joint.name);
         write!(out, ",{name}.x,{name}.y,{name}.z")?;
     }
     writeln!(out)?;
-    for f in 0..poses.frame_count {
-        write!(out, "{f},{}", f as f64 * motion.frame_time())?;
-        for p in poses.frame_positions(f) {
-            write!(out, ",{},{},{}", p.x, p.y, p.z)?;
+    for piece in frame_pieces(motion.frame_count()) {
+        let poses = forward_kinematics_range(motion, piece.clone());
+        for (k, f) in piece.enumerate() {
+            write!(out, "{f},{}", f as f64 * motion.frame_time())?;
+            for p in poses.frame_positions(k) {
+                write!(out, ",{},{},{}", p.x, p.y, p.z)?;
+            }
+            writeln!(out)?;
         }
-        writeln!(out)?;
     }
     Ok(())
 }
 
-/// Writes the positions of every frame as one JSON object.
-pub fn write_positions_json(
-    out: &mut dyn Write,
-    motion: &Motion,
-    poses: &GlobalPoses,
-) -> std::io::Result<()> {
+/// Writes the positions of every frame as one JSON object (a piece of the
+/// take at a time, as [`write_positions_csv`]).
+pub fn write_positions_json(out: &mut dyn Write, motion: &Motion) -> std::io::Result<()> {
     let skeleton = motion.skeleton();
     write!(out, "{{\"frame_time\":{},\"joints\":[", motion.frame_time())?;
     for (i, joint) in skeleton.joints().iter().enumerate() {
@@ -53,13 +50,16 @@ pub fn write_positions_json(
         }
     }
     write!(out, "],\"positions\":[")?;
-    for f in 0..poses.frame_count {
-        write!(out, "{}[", if f == 0 { "" } else { "," })?;
-        for (j, p) in poses.frame_positions(f).iter().enumerate() {
-            let sep = if j == 0 { "" } else { "," };
-            write!(out, "{sep}[{},{},{}]", p.x, p.y, p.z)?;
+    for piece in frame_pieces(motion.frame_count()) {
+        let poses = forward_kinematics_range(motion, piece.clone());
+        for (k, f) in piece.enumerate() {
+            write!(out, "{}[", if f == 0 { "" } else { "," })?;
+            for (j, p) in poses.frame_positions(k).iter().enumerate() {
+                let sep = if j == 0 { "" } else { "," };
+                write!(out, "{sep}[{},{},{}]", p.x, p.y, p.z)?;
+            }
+            write!(out, "]")?;
         }
-        write!(out, "]")?;
     }
     writeln!(out, "]}}")
 }
