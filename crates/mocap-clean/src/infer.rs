@@ -11,6 +11,13 @@
 //!
 //! Only rotations change: the output has the input's skeleton, channel
 //! layout and root translation.
+//!
+//! Memory: the take, its copy being cleaned and (for a model on a filter of
+//! the whole take) that filter's output. A window's rows are cut from the
+//! take as it is fed to the network (6D features computed for its frames
+//! alone), and after each batch of 256 windows the frames no later window
+//! sees are blended and decoded into the output, so nothing else grows
+//! with the take (`bench/results/memory.md`).
 
 use std::borrow::Cow;
 use std::path::PathBuf;
