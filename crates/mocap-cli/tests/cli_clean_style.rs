@@ -713,7 +713,7 @@ fn header_announcing(dir: &Path, name: &str, frames: usize) -> PathBuf {
 fn style_apply_refuses_takes_too_long_before_reading_them() {
     // Restyling holds the whole take several times over: a source of ten
     // hours (1,080,000 frames at 30 fps, about a 1.3 GB file) would need
-    // about 6.5 GB. It is refused from its header, with the file, its
+    // about 5.6 GB. It is refused from its header, with the file, its
     // length, the limit, the memory and how to cut it (reading it would
     // say the frames are missing).
     let dir = tempfile::tempdir().unwrap();
@@ -731,7 +731,7 @@ fn style_apply_refuses_takes_too_long_before_reading_them() {
         "ten-hours.bvh",
         "style apply works on takes of up to 108000 frames (about 60 minutes at 30 fps)",
         "this one has 1080000 (600 minutes)",
-        "6.5 GB",
+        "5.6 GB",
         "mocap convert",
         "--frames 0..108000",
     ] {

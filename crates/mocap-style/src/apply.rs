@@ -565,9 +565,10 @@ pub const MAX_SOURCE_SECONDS: f64 = 3600.0;
 pub const MAX_STYLE_SECONDS: f64 = 600.0;
 
 /// Peak memory of `mocap style apply` per source frame at the model's rate:
-/// the growth of its peak between the 10 MB and the 100 MB takes of
-/// `bench/memory.sh` (8,190 and 81,315 frames at 30 fps), rounded up.
-pub const SOURCE_BYTES_PER_FRAME: f64 = 6000.0;
+/// how its peak grows with the take's length in `bench/memory.sh` (from
+/// the 100 MB to the 1 GB take, before this limit: 81,315 to 812,565 frames
+/// of a Bandai walk at 30 fps, `bench/results/memory.md`).
+pub const SOURCE_BYTES_PER_FRAME: f64 = 5200.0;
 
 /// Memory per style clip frame: the clip's and its mirror's windows of 48
 /// frames of 32 latent numbers, as `f32`, and their codes.
