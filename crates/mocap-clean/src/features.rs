@@ -26,7 +26,7 @@ use mocap_core::rotation::{
     euler_to_quat, expmap_to_quat, quat_to_6d, quat_to_expmap, rot6d_to_quat, unwrap_track,
     AngleUnit, EulerOrder, Quat, Vec3,
 };
-use mocap_core::{forward_kinematics, Motion, Skeleton};
+use mocap_core::{Motion, Skeleton};
 use serde::{Deserialize, Serialize};
 
 use crate::{CleanError, Result};
@@ -207,32 +207,42 @@ impl FeatureLayout {
         Ok(self)
     }
 
-    /// The rotation of every feature joint in every frame, in the layout's
-    /// frame (frame after frame, `joints.len()` per frame).
-    fn feature_rotations(&self, motion: &Motion) -> Vec<Quat> {
-        let frames = motion.frame_count();
-        let mut out = Vec::with_capacity(frames * self.joints.len());
+    /// The rotation of every feature joint in frame `f`, in the layout's
+    /// frame, into `out`; `globals` is room for the global rotations the
+    /// pelvis frame needs (forward kinematics of that frame alone).
+    fn frame_rotations(
+        &self,
+        motion: &Motion,
+        f: usize,
+        globals: &mut Vec<Quat>,
+        out: &mut Vec<Quat>,
+    ) {
+        out.clear();
         match self.frame {
             RotationFrame::Local => {
-                for f in 0..frames {
-                    out.extend(self.joints.iter().map(|&j| motion.local_rotation(f, j)));
-                }
+                out.extend(self.joints.iter().map(|&j| motion.local_rotation(f, j)));
             }
             RotationFrame::Pelvis => {
-                let poses = forward_kinematics(motion);
-                for f in 0..frames {
-                    let pelvis = poses.rotation(f, self.pelvis).conjugate();
-                    out.extend(self.joints.iter().map(|&j| {
-                        if self.below_pelvis[j] {
-                            (pelvis * poses.rotation(f, j)).normalize()
-                        } else {
-                            motion.local_rotation(f, j)
-                        }
-                    }));
+                // As `forward_kinematics`: R_j = R_parent * q_j.
+                globals.clear();
+                for (j, joint) in motion.skeleton().joints().iter().enumerate() {
+                    let local = motion.local_rotation(f, j);
+                    let global = match joint.parent {
+                        Some(p) => globals[p] * local,
+                        None => local,
+                    };
+                    globals.push(global);
                 }
+                let pelvis = globals[self.pelvis].conjugate();
+                out.extend(self.joints.iter().map(|&j| {
+                    if self.below_pelvis[j] {
+                        (pelvis * globals[j]).normalize()
+                    } else {
+                        motion.local_rotation(f, j)
+                    }
+                }));
             }
         }
-        out
     }
 
     /// Features per frame.
@@ -249,26 +259,25 @@ impl FeatureLayout {
         let n = self.joints.len();
         match self.representation {
             Representation::Rot6d => {
-                let rotations = self.feature_rotations(motion);
+                let (mut globals, mut rotations) = (Vec::new(), Vec::with_capacity(n));
                 for f in 0..frames {
-                    for k in 0..n {
-                        let r = quat_to_6d(rotations[f * n + k]);
+                    self.frame_rotations(motion, f, &mut globals, &mut rotations);
+                    for (k, &q) in rotations.iter().enumerate() {
+                        let r = quat_to_6d(q);
                         out[f * c + k * dim..f * c + (k + 1) * dim].copy_from_slice(&r);
                     }
                 }
             }
             Representation::ExpMap => {
-                let rotations = self.feature_rotations(motion);
-                for k in 0..n {
-                    let mut previous = Quat::IDENTITY;
-                    for f in 0..frames {
+                let (mut globals, mut rotations) = (Vec::new(), Vec::with_capacity(n));
+                let mut previous = vec![Quat::IDENTITY; n];
+                for f in 0..frames {
+                    self.frame_rotations(motion, f, &mut globals, &mut rotations);
+                    for (k, (&q, previous)) in rotations.iter().zip(&mut previous).enumerate() {
                         // Keep the quaternion on the hemisphere of the previous
                         // frame's, so the rotation vector does not flip needlessly.
-                        let mut q = rotations[f * n + k];
-                        if q.dot(previous) < 0.0 {
-                            q = -q;
-                        }
-                        previous = q;
+                        let q = if q.dot(*previous) < 0.0 { -q } else { q };
+                        *previous = q;
                         let v = quat_to_expmap(q);
                         // quat_to_expmap takes w >= 0; for w < 0 write the
                         // equivalent longer vector to stay continuous.
@@ -307,6 +316,62 @@ impl FeatureLayout {
             }
         }
         out
+    }
+
+    /// The features of the frames `frames` of `motion`, one after the other,
+    /// when every frame's features are its own (6D rotations): the numbers
+    /// those frames have in [`FeatureLayout::encode`]'s features of the whole
+    /// take, computed without them. `None` for exponential maps and Euler
+    /// angles, which are kept continuous from the take's first frame.
+    pub fn encode_frames(
+        &self,
+        motion: &Motion,
+        frames: impl Iterator<Item = usize>,
+    ) -> Option<Vec<f32>> {
+        if self.representation != Representation::Rot6d {
+            return None;
+        }
+        let (mut globals, mut rotations) = (Vec::new(), Vec::with_capacity(self.joints.len()));
+        let mut out = Vec::new();
+        for f in frames {
+            self.frame_rotations(motion, f, &mut globals, &mut rotations);
+            for &q in &rotations {
+                out.extend_from_slice(&quat_to_6d(q));
+            }
+        }
+        Some(out)
+    }
+
+    /// The 6D features of feature joint `k` alone in every frame of `motion`
+    /// (6 per frame), for a layout of local 6D rotations: the same numbers as
+    /// that joint's in [`FeatureLayout::encode`]. `None` for other layouts.
+    pub(crate) fn encode_joint(&self, motion: &Motion, k: usize) -> Option<Vec<f32>> {
+        if (self.representation, self.frame) != (Representation::Rot6d, RotationFrame::Local) {
+            return None;
+        }
+        let j = self.joints[k];
+        let mut out = Vec::with_capacity(motion.frame_count() * 6);
+        for f in 0..motion.frame_count() {
+            out.extend_from_slice(&quat_to_6d(motion.local_rotation(f, j)));
+        }
+        Some(out)
+    }
+
+    /// Writes the rotations of feature joint `k` from `features` (6 per
+    /// frame, as [`FeatureLayout::encode_joint`] gives them) into `motion`,
+    /// as [`FeatureLayout::decode_into`] writes that joint: in the local
+    /// frame every joint is decoded on its own.
+    pub(crate) fn decode_joint_into(&self, features: &[f32], k: usize, motion: &mut Motion) {
+        debug_assert_eq!(self.frame, RotationFrame::Local);
+        let j = self.joints[k];
+        for (f, v) in features
+            .chunks_exact(6)
+            .enumerate()
+            .take(motion.frame_count())
+        {
+            let q = rot6d_to_quat([v[0], v[1], v[2], v[3], v[4], v[5]]);
+            set_rotation_keeping_branch(motion, f, j, q);
+        }
     }
 
     /// Brings a window of features to a canonical range before it is fed to
@@ -428,6 +493,14 @@ impl FeatureLayout {
     /// Writes the rotations in `features` (frame after frame) into `motion`'s
     /// rotation channels; position channels are left as they are.
     pub fn decode_into(&self, features: &[f32], motion: &mut Motion) {
+        let frames = motion.frame_count();
+        self.decode_frames_into(&features[..frames * self.channels()], 0, motion);
+    }
+
+    /// [`FeatureLayout::decode_into`] for the frames `first..` of `motion`
+    /// that `features` holds: every frame is decoded on its own, so a take
+    /// may be decoded piece by piece.
+    pub fn decode_frames_into(&self, features: &[f32], first: usize, motion: &mut Motion) {
         let c = self.channels();
         let joint_count = motion.skeleton().joint_count();
         let mut feature_of = vec![None; joint_count];
@@ -436,8 +509,7 @@ impl FeatureLayout {
         }
         // Rotations relative to the pelvis of the frame being decoded.
         let mut relative = vec![Quat::IDENTITY; joint_count];
-        for f in 0..motion.frame_count() {
-            let frame = &features[f * c..(f + 1) * c];
+        for (frame, f) in features.chunks_exact(c).zip(first..) {
             for j in 0..joint_count {
                 let decoded = feature_of[j].map(|k| self.rotation(frame, k));
                 let parent = motion.skeleton().joint(j).parent;
@@ -547,6 +619,7 @@ fn flip(flipped: &[bool], window: &mut [f32]) {
 mod tests {
     use super::*;
     use crate::test_support::synthetic_motion;
+    use mocap_core::forward_kinematics;
 
     #[test]
     fn every_representation_round_trips() {
@@ -633,6 +706,20 @@ mod tests {
             // Below the pelvis the features are P^-1 G_j.
             let poses = forward_kinematics(&motion);
             let c = layout.channels();
+            // Frame by frame, the bits of the whole take's kinematics.
+            if repr == Representation::Rot6d {
+                for f in 0..motion.frame_count() {
+                    for (k, &j) in layout.joints.iter().enumerate() {
+                        let q = if layout.below_pelvis[j] {
+                            (poses.rotation(f, 1).conjugate() * poses.rotation(f, j)).normalize()
+                        } else {
+                            motion.local_rotation(f, j)
+                        };
+                        let got = &features[f * c + 6 * k..f * c + 6 * k + 6];
+                        assert_eq!(got, &quat_to_6d(q)[..], "frame {f} joint {j}");
+                    }
+                }
+            }
             for f in [0, 17] {
                 let expected = poses.rotation(f, 1).conjugate() * poses.rotation(f, 6);
                 let got = layout.rotation(&features[f * c..(f + 1) * c], 5);

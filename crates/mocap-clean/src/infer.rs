@@ -11,6 +11,13 @@
 //!
 //! Only rotations change: the output has the input's skeleton, channel
 //! layout and root translation.
+//!
+//! Memory: the take, its copy being cleaned and (for a model on a filter of
+//! the whole take) that filter's output. A window's rows are cut from the
+//! take as it is fed to the network (6D features computed for its frames
+//! alone), and after each batch of 256 windows the frames no later window
+//! sees are blended and decoded into the output, so nothing else grows
+//! with the take (`bench/results/memory.md`).
 
 use std::borrow::Cow;
 use std::path::PathBuf;
@@ -23,6 +30,7 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
+use crate::features::Representation;
 use crate::filters::{filter_motion, Filter};
 use crate::metrics::rotation_error_deg;
 use crate::model_file::{window_base, with_base_input, Base, CleanModel, ModelFile};
@@ -76,7 +84,12 @@ impl CleanModel {
         if frames == 0 {
             return Ok((motion.clone(), None));
         }
-        let features = layout.encode(motion);
+        // The features of the whole take, unless a window's can be computed
+        // from its frames alone (6D rotations: `FeatureLayout::encode_frames`).
+        let features = match layout.representation {
+            Representation::Rot6d => None,
+            _ => Some(layout.encode(motion)),
+        };
         // A base filter that sees the whole take runs once, before the take
         // is cut into windows (see `ModelDescription::base_context`).
         let base = Base::of(
@@ -87,7 +100,10 @@ impl CleanModel {
         let mut outcome = None;
         let filtered_take = match &base {
             Some(base) if self.description.base_context > 0 => {
-                let mut filtered = features.clone();
+                let mut filtered = match &features {
+                    Some(features) => features.clone(),
+                    None => layout.encode(motion),
+                };
                 outcome = base.apply_reporting(&mut filtered, c, level_deg);
                 Some(filtered)
             }
@@ -95,20 +111,21 @@ impl CleanModel {
         };
         let noise_deg = outcome.map(|o| o.sigma_deg);
         // Pad by repeating the edge frames: half a window in front, and at
-        // the end enough for the last window to be whole.
+        // the end enough for the last window to be whole. The padded take
+        // is not made: a window's rows are cut from the take.
         let front = t / 2;
         let windows = (frames + front).div_ceil(hop).max(1);
         let padded_len = (windows - 1) * hop + t;
-        let pad = |features: &[f32]| {
-            let mut padded = Vec::with_capacity(padded_len * c);
-            for i in 0..padded_len {
-                let f = (i as isize - front as isize).clamp(0, frames as isize - 1) as usize;
-                padded.extend_from_slice(&features[f * c..(f + 1) * c]);
-            }
-            padded
+        let take_frames = |s: usize| {
+            (s..s + t).map(|i| (i as isize - front as isize).clamp(0, frames as isize - 1) as usize)
         };
-        let padded = pad(&features);
-        let padded_filtered = filtered_take.as_deref().map(pad);
+        let rows = |features: &[f32], s: usize| {
+            let mut window = Vec::with_capacity(t * c);
+            for f in take_frames(s) {
+                window.extend_from_slice(&features[f * c..(f + 1) * c]);
+            }
+            window
+        };
         let weight: Vec<f32> = (0..t)
             .map(|k| {
                 (std::f32::consts::PI * (k as f32 + 0.5) / t as f32)
@@ -116,8 +133,13 @@ impl CleanModel {
                     .powi(2)
             })
             .collect();
-        let mut sum = vec![0.0f32; padded_len * c];
-        let mut weight_sum = vec![0.0f32; padded_len];
+        // The weighted sums of the windows' outputs, from padded frame
+        // `done` on: the frames before the next batch's first window are
+        // whole, and are decoded into the output as soon as they are.
+        let mut sum: Vec<f32> = Vec::new();
+        let mut weight_sum: Vec<f32> = Vec::new();
+        let mut done = 0;
+        let mut out = motion.clone();
         let batch = 256;
         let mut start_index = 0;
         while start_index < windows {
@@ -128,13 +150,16 @@ impl CleanModel {
             let mut base_corrections = Vec::new();
             for b in 0..n {
                 let s = (start_index + b) * hop;
-                let mut w = padded[s * c..(s + t) * c].to_vec();
+                let mut w = match &features {
+                    Some(features) => rows(features, s),
+                    None => layout
+                        .encode_frames(motion, take_frames(s))
+                        .expect("6D features are encoded frame by frame"),
+                };
                 let recentering = layout.recenter(&mut w);
                 let filtered = base.as_ref().map(|base| {
-                    let around = padded_filtered
-                        .as_deref()
-                        .map(|take| &take[s * c..(s + t) * c]);
-                    window_base(&w, around, &recentering, base, c, level_deg)
+                    let around = filtered_take.as_deref().map(|take| rows(take, s));
+                    window_base(&w, around.as_deref(), &recentering, base, c, level_deg)
                 });
                 offsets.push(recentering);
                 if let Some((filtered, window_level)) = filtered {
@@ -160,6 +185,9 @@ impl CleanModel {
             let y: Vec<f32> = output
                 .try_to_vec()
                 .map_err(|e| CleanError::Invalid(format!("reading the network output: {e:?}")))?;
+            let end = (start_index + n - 1) * hop + t;
+            sum.resize((end - done) * c, 0.0);
+            weight_sum.resize(end - done, 0.0);
             let mut out_window = vec![0.0; t * c];
             for (b, recentering) in offsets.iter().enumerate() {
                 for f in 0..t {
@@ -174,7 +202,7 @@ impl CleanModel {
                 }
                 // Back on the take's branch before blending.
                 recentering.undo(&mut out_window);
-                let s = (start_index + b) * hop;
+                let s = (start_index + b) * hop - done;
                 for f in 0..t {
                     let w = weight[f];
                     weight_sum[s + f] += w;
@@ -184,16 +212,26 @@ impl CleanModel {
                 }
             }
             start_index += n;
-        }
-        let mut cleaned = vec![0.0; frames * c];
-        for f in 0..frames {
-            let p = f + front;
-            for ch in 0..c {
-                cleaned[f * c + ch] = sum[p * c + ch] / weight_sum[p];
+            let whole = if start_index < windows {
+                start_index * hop
+            } else {
+                padded_len
+            };
+            let (first, last) = (done.max(front), whole.min(front + frames));
+            if first < last {
+                let mut cleaned = vec![0.0; (last - first) * c];
+                for p in first..last {
+                    for ch in 0..c {
+                        cleaned[(p - first) * c + ch] =
+                            sum[(p - done) * c + ch] / weight_sum[p - done];
+                    }
+                }
+                layout.decode_frames_into(&cleaned, first - front, &mut out);
             }
+            sum.drain(..(whole - done) * c);
+            weight_sum.drain(..whole - done);
+            done = whole;
         }
-        let mut out = motion.clone();
-        layout.decode_into(&cleaned, &mut out);
         Ok((out, outcome))
     }
 }
@@ -409,6 +447,168 @@ mod tests {
             training: serde_json::Value::Null,
         };
         weights_to_bytes(model, &header).unwrap()
+    }
+
+    /// Cleaning as it was written before the blend was decoded batch by
+    /// batch: the padded take and the weighted sums of the whole take.
+    fn whole_take_blend(
+        model: &CleanModel,
+        motion: &Motion,
+        hop: Option<usize>,
+        level_deg: Option<f64>,
+    ) -> Result<(Motion, Option<WienerOutcome>)> {
+        let layout = model.layout_for(motion)?;
+        let c = layout.channels();
+        let ci = model.description.network.input_channels();
+        let t = model.description.network.window;
+        let hop = hop.unwrap_or(t / 4).clamp(1, t);
+        let frames = motion.frame_count();
+        if frames == 0 {
+            return Ok((motion.clone(), None));
+        }
+        let features = layout.encode(motion);
+        // A base filter that sees the whole take runs once, before the take
+        // is cut into windows (see `ModelDescription::base_context`).
+        let base = Base::of(
+            model.description.base_filter,
+            model.description.fps,
+            model.base_wiener.as_ref(),
+        );
+        let mut outcome = None;
+        let filtered_take = match &base {
+            Some(base) if model.description.base_context > 0 => {
+                let mut filtered = features.clone();
+                outcome = base.apply_reporting(&mut filtered, c, level_deg);
+                Some(filtered)
+            }
+            _ => None,
+        };
+        let noise_deg = outcome.map(|o| o.sigma_deg);
+        // Pad by repeating the edge frames: half a window in front, and at
+        // the end enough for the last window to be whole.
+        let front = t / 2;
+        let windows = (frames + front).div_ceil(hop).max(1);
+        let padded_len = (windows - 1) * hop + t;
+        let pad = |features: &[f32]| {
+            let mut padded = Vec::with_capacity(padded_len * c);
+            for i in 0..padded_len {
+                let f = (i as isize - front as isize).clamp(0, frames as isize - 1) as usize;
+                padded.extend_from_slice(&features[f * c..(f + 1) * c]);
+            }
+            padded
+        };
+        let padded = pad(&features);
+        let padded_filtered = filtered_take.as_deref().map(pad);
+        let weight: Vec<f32> = (0..t)
+            .map(|k| {
+                (std::f32::consts::PI * (k as f32 + 0.5) / t as f32)
+                    .sin()
+                    .powi(2)
+            })
+            .collect();
+        let mut sum = vec![0.0f32; padded_len * c];
+        let mut weight_sum = vec![0.0f32; padded_len];
+        let batch = 256;
+        let mut start_index = 0;
+        while start_index < windows {
+            let n = batch.min(windows - start_index);
+            let mut x = vec![0.0; n * ci * t];
+            let mut offsets = Vec::with_capacity(n);
+            // Per window, base(x) - x (see `ModelDescription::base_filter`).
+            let mut base_corrections = Vec::new();
+            for b in 0..n {
+                let s = (start_index + b) * hop;
+                let mut w = padded[s * c..(s + t) * c].to_vec();
+                let recentering = layout.recenter(&mut w);
+                let filtered = base.as_ref().map(|base| {
+                    let around = padded_filtered
+                        .as_deref()
+                        .map(|take| &take[s * c..(s + t) * c]);
+                    window_base(&w, around, &recentering, base, c, level_deg)
+                });
+                offsets.push(recentering);
+                if let Some((filtered, window_level)) = filtered {
+                    base_corrections.push(
+                        filtered
+                            .iter()
+                            .zip(&w)
+                            .map(|(f, x)| f - x)
+                            .collect::<Vec<f32>>(),
+                    );
+                    if model.description.base_input() {
+                        w = with_base_input(&w, &filtered, noise_deg.or(window_level), c);
+                    }
+                }
+                for f in 0..t {
+                    for ch in 0..ci {
+                        x[(b * ci + ch) * t + f] = w[f * ci + ch];
+                    }
+                }
+            }
+            let input = Tensor::<3>::from_data(TensorData::new(x, [n, ci, t]), &model.device);
+            let output = model.model.forward(input).into_data();
+            let y: Vec<f32> = output
+                .try_to_vec()
+                .map_err(|e| CleanError::Invalid(format!("reading the network output: {e:?}")))?;
+            let mut out_window = vec![0.0; t * c];
+            for (b, recentering) in offsets.iter().enumerate() {
+                for f in 0..t {
+                    for ch in 0..c {
+                        out_window[f * c + ch] = y[(b * c + ch) * t + f];
+                    }
+                }
+                if let Some(correction) = base_corrections.get(b) {
+                    for (o, d) in out_window.iter_mut().zip(correction) {
+                        *o += d;
+                    }
+                }
+                // Back on the take's branch before blending.
+                recentering.undo(&mut out_window);
+                let s = (start_index + b) * hop;
+                for f in 0..t {
+                    let w = weight[f];
+                    weight_sum[s + f] += w;
+                    for ch in 0..c {
+                        sum[(s + f) * c + ch] += w * out_window[f * c + ch];
+                    }
+                }
+            }
+            start_index += n;
+        }
+        let mut cleaned = vec![0.0; frames * c];
+        for f in 0..frames {
+            let p = f + front;
+            for ch in 0..c {
+                cleaned[f * c + ch] = sum[p * c + ch] / weight_sum[p];
+            }
+        }
+        let mut out = motion.clone();
+        layout.decode_into(&cleaned, &mut out);
+        Ok((out, outcome))
+    }
+
+    /// The blend decoded batch by batch gives the bits of blending the
+    /// whole take at once, on a real take long enough for several batches
+    /// of windows (the sample walk played 12 times: 2,340 frames).
+    #[test]
+    fn batches_give_the_bits_of_the_whole_take() {
+        let walk = read_bvh(&mocap_testdata::sample_walk()).unwrap();
+        let mut take = walk.clone();
+        for _ in 1..12 {
+            take.append(&walk).unwrap();
+        }
+        let model = CleanModel::load_default(DeviceChoice::Cpu).unwrap();
+        for hop in [None, Some(5)] {
+            let (expected, expected_outcome) = whole_take_blend(&model, &take, hop, None).unwrap();
+            let (got, outcome) = model.clean_describing(&take, hop, None).unwrap();
+            assert_eq!(outcome, expected_outcome);
+            let same = got
+                .values()
+                .iter()
+                .zip(expected.values())
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "hop {hop:?}: other values");
+        }
     }
 
     #[test]

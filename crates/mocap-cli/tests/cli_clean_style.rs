@@ -695,6 +695,67 @@ fn unusable_inputs_are_refused_naming_the_file() {
     assert!(!output.exists());
 }
 
+/// The bundled walk's header announcing `frames` frames, and no frame
+/// lines: a take of that length as far as its header says.
+fn header_announcing(dir: &Path, name: &str, frames: usize) -> PathBuf {
+    let text = std::fs::read_to_string(sample("dataset-1_walk_normal_001.bvh")).unwrap();
+    let motion = text.find("MOTION").unwrap();
+    let header = format!(
+        "{}MOTION\nFrames: {frames}\nFrame Time: 0.0333333\n",
+        &text[..motion]
+    );
+    let file = dir.join(name);
+    std::fs::write(&file, header).unwrap();
+    file
+}
+
+#[test]
+fn style_apply_refuses_takes_too_long_before_reading_them() {
+    // Restyling holds the whole take several times over: a source of ten
+    // hours (1,080,000 frames at 30 fps, about a 1.3 GB file) would need
+    // about 5.6 GB. It is refused from its header, with the file, its
+    // length, the limit, the memory and how to cut it (reading it would
+    // say the frames are missing).
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("out.bvh");
+    let long = header_announcing(dir.path(), "ten-hours.bvh", 1_080_000);
+    let out = style_apply(
+        path(&long),
+        &sample("dataset-1_walk_proud_001.bvh"),
+        &output,
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let says = stderr(&out);
+    for part in [
+        "ten-hours.bvh",
+        "style apply works on takes of up to 108000 frames (about 60 minutes at 30 fps)",
+        "this one has 1080000 (600 minutes)",
+        "5.6 GB",
+        "mocap convert",
+        "--frames 0..108000",
+    ] {
+        assert!(says.contains(part), "no {part:?} in: {says}");
+    }
+    assert!(!output.exists());
+    // A style clip is an example: up to ten minutes.
+    let long_style = header_announcing(dir.path(), "long-style.bvh", 20_000);
+    let out = style_apply(
+        &sample("dataset-1_walk_normal_001.bvh"),
+        path(&long_style),
+        &output,
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let says = stderr(&out);
+    assert!(
+        says.contains("long-style.bvh")
+            && says.contains("style apply works on style clips of up to 18000 frames"),
+        "{says}"
+    );
+    assert!(!output.exists());
+}
+
 #[test]
 fn style_clips_and_sources_of_other_rigs_are_retargeted() {
     let (Some(mixamo), Some(cmu), Some(two_joints)) = (

@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::bodymap::{BodyMap, BodyPart};
 use crate::error::Result;
 use crate::io::MotionSource;
-use crate::kinematics::forward_kinematics;
+use crate::kinematics::bounding_box;
 use crate::motion::Motion;
 
 /// What `mocap info` reports about one motion.
@@ -38,7 +38,6 @@ impl MotionInfo {
     /// Describes `motion`, read from the file named `file`.
     pub fn of(file: impl Into<String>, motion: &Motion) -> MotionInfo {
         let skeleton = motion.skeleton();
-        let poses = forward_kinematics(motion);
         let map = BodyMap::detect(skeleton).ok();
         MotionInfo {
             file: file.into(),
@@ -49,9 +48,7 @@ impl MotionInfo {
             frame_time: motion.frame_time(),
             fps: motion.fps(),
             duration_seconds: motion.duration(),
-            bounding_box: poses
-                .bounding_box()
-                .map(|(lo, hi)| [lo.to_array(), hi.to_array()]),
+            bounding_box: bounding_box(motion).map(|(lo, hi)| [lo.to_array(), hi.to_array()]),
             root: skeleton
                 .joints()
                 .first()

@@ -10,6 +10,8 @@
 //!
 //! and a root has `R_j = q_j`, `x_j = t_j`.
 
+use std::ops::Range;
+
 use crate::motion::{local_rotation_of, local_translation_of, Motion};
 use crate::rotation::{Quat, Vec3};
 
@@ -56,11 +58,19 @@ impl GlobalPoses {
 
 /// Global poses of every frame of `motion`.
 pub fn forward_kinematics(motion: &Motion) -> GlobalPoses {
+    forward_kinematics_range(motion, 0..motion.frame_count())
+}
+
+/// Global poses of the frames `frames` of `motion`, the first of them at
+/// index 0 of the result: the same numbers as [`forward_kinematics`] gives
+/// those frames, for going through a long take a piece at a time
+/// ([`FRAMES_AT_A_TIME`]).
+pub fn forward_kinematics_range(motion: &Motion, frames: Range<usize>) -> GlobalPoses {
     let skeleton = motion.skeleton();
     let n = skeleton.joint_count();
-    let frames = motion.frame_count();
-    let mut positions = Vec::with_capacity(n * frames);
-    let mut rotations = Vec::with_capacity(n * frames);
+    let count = frames.len();
+    let mut positions = Vec::with_capacity(n * count);
+    let mut rotations = Vec::with_capacity(n * count);
     let joints = skeleton.joints();
     let spans: Vec<(usize, usize)> = (0..n)
         .map(|j| {
@@ -68,7 +78,7 @@ pub fn forward_kinematics(motion: &Motion) -> GlobalPoses {
             (start, start + joints[j].channels.len())
         })
         .collect();
-    for f in 0..frames {
+    for f in frames {
         let frame = motion.frame(f);
         let base = positions.len();
         for (joint, &(start, end)) in joints.iter().zip(&spans) {
@@ -88,10 +98,44 @@ pub fn forward_kinematics(motion: &Motion) -> GlobalPoses {
     }
     GlobalPoses {
         joint_count: n,
-        frame_count: frames,
+        frame_count: count,
         positions,
         rotations,
     }
+}
+
+/// Frames whose poses are computed at a time by what goes through a whole
+/// take ([`bounding_box`], the positions writers): their memory does not
+/// grow with the take.
+pub const FRAMES_AT_A_TIME: usize = 1024;
+
+/// The pieces of `FRAMES_AT_A_TIME` frames of a take of `frames` frames.
+pub fn frame_pieces(frames: usize) -> impl Iterator<Item = Range<usize>> {
+    (0..frames)
+        .step_by(FRAMES_AT_A_TIME)
+        .map(move |start| start..(start + FRAMES_AT_A_TIME).min(frames))
+}
+
+/// Smallest and largest global joint coordinates over all joints and
+/// frames of `motion` ([`GlobalPoses::bounding_box`] of its
+/// [`forward_kinematics`]), `None` for a motion without frames; the poses
+/// are computed a piece at a time.
+pub fn bounding_box(motion: &Motion) -> Option<(Vec3, Vec3)> {
+    let mut bounds: Option<(Vec3, Vec3)> = None;
+    for piece in frame_pieces(motion.frame_count()) {
+        let poses = forward_kinematics_range(motion, piece);
+        let Some(&first) = poses.positions.first() else {
+            continue;
+        };
+        let start = bounds.unwrap_or((first, first));
+        bounds = Some(
+            poses
+                .positions
+                .iter()
+                .fold(start, |(lo, hi), &p| (lo.min(p), hi.max(p))),
+        );
+    }
+    bounds
 }
 
 /// Global positions of the end sites of every joint in one frame, as

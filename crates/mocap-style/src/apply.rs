@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mocap_core::bodymap::BodyMap;
-use mocap_core::io::{read_motion, write_motion};
+use mocap_core::io::{read_motion, write_motion, MotionSource};
 use mocap_core::ops::resample_fps;
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, Vec3};
@@ -552,17 +552,109 @@ fn retargeting(from: &Motion, to: &Motion) -> mocap_core::Result<Retargeting> {
     Retargeting::new(from, &from_map, to, &to_map)
 }
 
+/// The longest source [`apply`] restyles, in seconds: an hour. A restyle
+/// holds the whole take several times over (its latent codes whiten it as a
+/// whole, its gait sets the asymmetry window, the feet carry the root along
+/// it): about [`SOURCE_BYTES_PER_FRAME`] per frame at the model's rate, so
+/// a longer take is refused before it is read, with the memory it would need.
+pub const MAX_SOURCE_SECONDS: f64 = 3600.0;
+
+/// The longest style clip [`apply`] takes, in seconds: ten minutes. Every
+/// window of a style clip and of its mirror is kept and compared with every
+/// patch of the source (about [`STYLE_BYTES_PER_FRAME`] per frame).
+pub const MAX_STYLE_SECONDS: f64 = 600.0;
+
+/// Peak memory of `mocap style apply` per source frame at the model's rate:
+/// how its peak grows with the take's length in `bench/memory.sh` (from
+/// the 100 MB to the 1 GB take, before this limit: 81,315 to 812,565 frames
+/// of a Bandai walk at 30 fps, `bench/results/memory.md`).
+pub const SOURCE_BYTES_PER_FRAME: f64 = 5200.0;
+
+/// Memory per style clip frame: the clip's and its mirror's windows of 48
+/// frames of 32 latent numbers, as `f32`, and their codes.
+pub const STYLE_BYTES_PER_FRAME: f64 = 13000.0;
+
+/// Refuses a take of `frames` frames `frame_time` apart that is longer
+/// than `max_seconds`, naming the file, its length, the limit and the
+/// memory it would need at `bytes_per_frame` per frame at `model_fps`.
+fn check_length(
+    path: &Path,
+    what: &str,
+    (frames, frame_time): (usize, f64),
+    max_seconds: f64,
+    model_fps: f64,
+    bytes_per_frame: f64,
+) -> Result<()> {
+    let seconds = frames as f64 * frame_time;
+    if seconds <= max_seconds {
+        return Ok(());
+    }
+    let fps = 1.0 / frame_time;
+    let limit = (max_seconds * fps).floor() as usize;
+    let minutes = |s: f64| format!("{:.0} minutes", s / 60.0);
+    let gigabytes = seconds * model_fps * bytes_per_frame / 1e9;
+    Err(invalid(format!(
+        "{name}: style apply works on {what}s of up to {limit} frames (about {} at {fps:.0} fps); \
+         this one has {frames} ({}), which would need about {gigabytes:.1} GB of memory: cut it \
+         first, e.g. `mocap convert {name} --frames 0..{limit} part.bvh`",
+        minutes(max_seconds),
+        minutes(seconds),
+        name = path.display(),
+    )))
+}
+
+/// Reads a source or style clip after checking its length (see
+/// [`check_length`]): from its header where the file says it (BVH), so that
+/// a take too long is refused before it is read; else once read.
+fn read_checked(
+    path: &Path,
+    what: &str,
+    max_seconds: f64,
+    model_fps: f64,
+    bytes_per_frame: f64,
+) -> Result<Motion> {
+    let check = |length| check_length(path, what, length, max_seconds, model_fps, bytes_per_frame);
+    let sources = MotionSource::group(&[path.to_path_buf()])?;
+    if let Some(length) = sources
+        .first()
+        .map(MotionSource::announced_length)
+        .transpose()?
+        .flatten()
+    {
+        check(length)?;
+    }
+    let motion = read_motion(path)?;
+    check((motion.frame_count(), motion.frame_time()))?;
+    Ok(motion)
+}
+
 /// Restyles a file and writes the result (see the module docs).
 pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
     let t = Instant::now();
     let model = load_model(options.model.as_deref(), options.device)?;
-    let source = read_motion(&options.source)?;
+    let fps = model.description.fps;
+    let source = read_checked(
+        &options.source,
+        "take",
+        MAX_SOURCE_SECONDS,
+        fps,
+        SOURCE_BYTES_PER_FRAME,
+    )?;
     // Checked here too, where the source's file name is known: the restyle
     // itself names it only "source".
     crate::train::require_two_frames(&source, &options.source.display().to_string())?;
-    let style = read_motion(&options.style)?;
+    let style_clip = |path: &Path| {
+        read_checked(
+            path,
+            "style clip",
+            MAX_STYLE_SECONDS,
+            fps,
+            STYLE_BYTES_PER_FRAME,
+        )
+    };
+    let style = style_clip(&options.style)?;
     let blend = match &options.blend {
-        Some((path, w)) => Some((read_motion(path)?, *w, path)),
+        Some((path, w)) => Some((style_clip(path)?, *w, path)),
         None => None,
     };
     // The rig the restyle runs on: the source's when it is the model's,

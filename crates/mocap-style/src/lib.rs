@@ -30,7 +30,10 @@
 //!    turns keeps both ([`Asymmetry`]). The planted feet carry the root
 //!    within each stride ([`RootPath`]), and [`clean_foot_contacts`] can pin
 //!    the feet during ground contacts afterwards (opt-in).
-//! 4. [`apply`] does the whole thing on files (`mocap style apply`);
+//! 4. [`apply`] does the whole thing on files (`mocap style apply`), on
+//!    sources of up to [`MAX_SOURCE_SECONDS`] and style clips of up to
+//!    [`MAX_STYLE_SECONDS`] (a restyle holds the whole take: a longer one is
+//!    refused before it is read, with the memory it would need);
 //!    [`restyle`] on motions in memory. [`evaluate`] measures it on
 //!    labelled clips (`mocap style eval`) with judges independent of the
 //!    model: random forests of `mocap-search` over its body-relative pose
@@ -108,7 +111,8 @@ mod train;
 pub use apply::{
     apply, load_model, parse_blend, prepare_source, prepare_style, restyle, restyle_prepared,
     source_reconstruction_deg, ApplyOptions, ApplyReport, PreparedSource, Restyled, StageTimings,
-    StyleClip, BUILT_IN_MODEL, UNFAMILIAR_SOURCE_DEG,
+    StyleClip, BUILT_IN_MODEL, MAX_SOURCE_SECONDS, MAX_STYLE_SECONDS, SOURCE_BYTES_PER_FRAME,
+    STYLE_BYTES_PER_FRAME, UNFAMILIAR_SOURCE_DEG,
 };
 pub use contact::{clean_foot_contacts, travelled, ContactOptions, ContactReport, RootShift};
 pub use convert::{

@@ -1,7 +1,6 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use mocap_core::forward_kinematics;
 use mocap_core::io::positions::{write_positions_csv, write_positions_json};
 use mocap_core::io::MotionSource;
 
@@ -29,12 +28,11 @@ pub fn run(args: Args, _options: &GlobalOptions) -> anyhow::Result<()> {
         bail!("`mocap positions` takes one motion, got {}", sources.len());
     };
     let motion = source.read()?;
-    let poses = forward_kinematics(&motion);
     write_output(args.output.as_deref(), |w| {
         if args.json {
-            write_positions_json(w, &motion, &poses)
+            write_positions_json(w, &motion)
         } else {
-            write_positions_csv(w, &motion, &poses)
+            write_positions_csv(w, &motion)
         }
     })
 }

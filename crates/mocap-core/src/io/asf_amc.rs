@@ -74,7 +74,9 @@
 //! which is the default of [`AsfOptions::frame_rate`]. (HDM05 names a file's
 //! rate at the end of its name, as in `..._120.amc`.)
 
+use std::borrow::Cow;
 use std::collections::HashMap;
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
@@ -453,8 +455,12 @@ pub fn read_amc_with(
     options: &AsfOptions,
 ) -> Result<Motion> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse_amc(&bytes, path, skeleton, options)
+    check_frame_rate(options)?;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    // Line by line: memory holds the values, not the file's text too.
+    let lines = StreamedLines::new(std::io::BufReader::with_capacity(1 << 16, file), path);
+    let (values, frame_count, angle) = read_amc_values(lines, path, skeleton)?;
+    build_motion(skeleton, &values, frame_count, angle, options)
 }
 
 /// Reads an ASF skeleton and an AMC motion of it with the default options
@@ -496,15 +502,92 @@ fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
             None => (rest, ""),
         };
         rest = next;
-        // Comments are whole lines. A `#` inside a line is kept: Vicon
-        // writes a missing value as `1.#QNAN`, which must be an error, not 1.
-        let line = if line.trim_start().starts_with('#') {
-            ""
-        } else {
-            line
-        };
-        Some((number, line))
+        Some((number, without_comment(line)))
     })
+}
+
+/// Comments are whole lines. A `#` inside a line is kept: Vicon writes a
+/// missing value as `1.#QNAN`, which must be an error, not 1.
+fn without_comment(line: &str) -> &str {
+    if line.trim_start().starts_with('#') {
+        ""
+    } else {
+        line
+    }
+}
+
+/// [`lines`] read from a file one at a time (each decoded lossily, as the
+/// whole text would be: no UTF-8 sequence holds a line end), so that a long
+/// motion is not held as text beside its values.
+struct StreamedLines<'p, R> {
+    reader: R,
+    path: &'p Path,
+    number: usize,
+    line: Vec<u8>,
+}
+
+impl<'p, R: BufRead> StreamedLines<'p, R> {
+    fn new(reader: R, path: &'p Path) -> Self {
+        StreamedLines {
+            reader,
+            path,
+            number: 0,
+            line: Vec::new(),
+        }
+    }
+
+    /// The next line's bytes into `self.line`; `false` at the end.
+    fn advance(&mut self) -> std::io::Result<bool> {
+        self.line.clear();
+        let mut started = false;
+        loop {
+            let available = self.reader.fill_buf()?;
+            if available.is_empty() {
+                return Ok(started);
+            }
+            started = true;
+            match available.iter().position(|&b| b == b'\n' || b == b'\r') {
+                Some(i) => {
+                    let cr = available[i] == b'\r';
+                    self.line.extend_from_slice(&available[..i]);
+                    self.reader.consume(i + 1);
+                    if cr && self.reader.fill_buf()?.first() == Some(&b'\n') {
+                        self.reader.consume(1);
+                    }
+                    return Ok(true);
+                }
+                None => {
+                    let n = available.len();
+                    self.line.extend_from_slice(available);
+                    self.reader.consume(n);
+                }
+            }
+        }
+    }
+}
+
+impl<R: BufRead> Iterator for StreamedLines<'_, R> {
+    type Item = Result<(usize, Cow<'static, str>)>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        match self.advance() {
+            Ok(false) => None,
+            Ok(true) => {
+                self.number += 1;
+                let text = String::from_utf8_lossy(&self.line);
+                Some(Ok((
+                    self.number,
+                    Cow::Owned(without_comment(&text).to_string()),
+                )))
+            }
+            Err(e) => Some(Err(Error::io(self.path, e))),
+        }
+    }
+}
+
+/// The lines of a text in memory, as [`read_amc_values`] takes them.
+fn text_lines(text: &str) -> impl Iterator<Item = Result<(usize, Cow<'_, str>)>> {
+    lines(text).map(|(number, line)| Ok((number, Cow::Borrowed(line))))
 }
 
 /// A word of a line and its byte offset in the line.
@@ -1150,15 +1233,20 @@ pub fn parse_amc(
     skeleton: &AsfSkeleton,
     options: &AsfOptions,
 ) -> Result<Motion> {
+    check_frame_rate(options)?;
+    let text = String::from_utf8_lossy(bytes);
+    let (values, frame_count, angle) = read_amc_values(text_lines(&text), path, skeleton)?;
+    build_motion(skeleton, &values, frame_count, angle, options)
+}
+
+fn check_frame_rate(options: &AsfOptions) -> Result<()> {
     if !(options.frame_rate.is_finite() && options.frame_rate > 0.0) {
         return Err(Error::Invalid(format!(
             "the frame rate must be a positive number of frames per second, got {}",
             options.frame_rate
         )));
     }
-    let text = String::from_utf8_lossy(bytes);
-    let (values, frame_count, angle) = read_amc_values(&text, path, skeleton)?;
-    build_motion(skeleton, &values, frame_count, angle, options)
+    Ok(())
 }
 
 /// Segment names of an AMC line: the root or a bone.
@@ -1171,8 +1259,8 @@ enum Segment {
 /// The values of every frame, laid out as the root's then each bone's in
 /// file order ([`AsfSkeleton::dof_count`] per frame), the frame count and
 /// the angle unit.
-fn read_amc_values(
-    text: &str,
+fn read_amc_values<'t>(
+    lines: impl Iterator<Item = Result<(usize, Cow<'t, str>)>>,
     path: &Path,
     skeleton: &AsfSkeleton,
 ) -> Result<(Vec<f32>, usize, AngleUnit)> {
@@ -1234,7 +1322,9 @@ fn read_amc_values(
             None => Ok(()),
         }
     };
-    for (number, line) in lines(text) {
+    for item in lines {
+        let (number, line) = item?;
+        let line: &str = &line;
         let words = tokens(line);
         let Some(&first) = words.first() else {
             continue;
@@ -1483,6 +1573,49 @@ fn joint_plans<'a>(asf: &'a AsfSkeleton, skeleton: &Skeleton) -> Vec<JointPlan<'
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Lines read from a file one at a time are the lines of its whole
+    /// text, whatever the reader's buffer cuts (a `\r\n` split between two
+    /// fills, a UTF-8 sequence cut, a line longer than the buffer).
+    #[test]
+    fn streamed_lines_are_the_lines_of_the_whole_text() {
+        let texts: [&[u8]; 6] = [
+            b"a\r\nb\nc\r  # note\n\n1.#QNAN",
+            b"\r\n\r\r\n\n\n",
+            b"root 1 2 3\r\nlfemur 4\xff 5\xc3\xa9 6\r\n",
+            b"no ending",
+            b"",
+            b"a long line that no buffer of a few bytes holds at once\rx\n",
+        ];
+        for bytes in texts {
+            let text = String::from_utf8_lossy(bytes);
+            let expected: Vec<(usize, String)> =
+                lines(&text).map(|(n, l)| (n, l.to_string())).collect();
+            for capacity in [1, 2, 3, 7, 64] {
+                let reader = std::io::BufReader::with_capacity(capacity, bytes);
+                let got: Vec<(usize, String)> = StreamedLines::new(reader, Path::new("x.amc"))
+                    .map(|item| item.map(|(n, l)| (n, l.into_owned())).unwrap())
+                    .collect();
+                assert_eq!(got, expected, "{bytes:?} read {capacity} bytes at a time");
+            }
+        }
+    }
+
+    /// A real AMC motion read from its file line by line is the motion
+    /// parsed from its bytes.
+    #[test]
+    fn an_amc_file_reads_as_its_bytes_parse() {
+        let Some(dir) = mocap_testdata::shared("hdm05-sample") else {
+            eprintln!("note: ../shared/data/hdm05-sample is absent; skipped");
+            return;
+        };
+        let skeleton = read_asf(dir.join("HDM_bd.asf")).unwrap();
+        let amc = dir.join("HDM_bd_depositFloorR_001_120.amc");
+        let read = read_amc(&amc, &skeleton).unwrap();
+        let bytes = std::fs::read(&amc).unwrap();
+        let parsed = parse_amc(&bytes, &amc, &skeleton, &AsfOptions::default()).unwrap();
+        assert_eq!(read, parsed);
+    }
 
     #[test]
     fn lines_split_at_every_ending_and_drop_comments() {

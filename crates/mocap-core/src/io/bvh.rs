@@ -105,6 +105,17 @@ pub fn read_bvh(path: &Path) -> Result<Motion> {
     Parser::new(reader, path, file_size).parse()
 }
 
+/// What the header of a BVH file says, read without its frame lines: the
+/// skeleton, the number of frames `Frames:` announces and the frame time
+/// (a file with another number of frame lines is refused by [`read_bvh`]).
+/// For judging the size of a take before reading it.
+pub fn read_bvh_header(path: &Path) -> Result<(Skeleton, usize, f64)> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut parser = Parser::new(BufReader::with_capacity(1 << 16, file), path, None);
+    let (skeleton, header) = parser.parse_header()?;
+    Ok((skeleton, header.frames, header.frame_time))
+}
+
 /// Reads BVH text from `reader`; `path_for_errors` is the name that errors
 /// give for the source.
 pub fn read_bvh_from<R: BufRead>(reader: R, path_for_errors: &Path) -> Result<Motion> {
@@ -530,6 +541,13 @@ impl<R: BufRead> Parser<R> {
     }
 
     fn parse(mut self) -> Result<Motion> {
+        let (skeleton, header) = self.parse_header()?;
+        let values = self.parse_frames(skeleton.channel_count(), &header)?;
+        Motion::new(skeleton, header.frame_time, header.frames, values)
+    }
+
+    /// The hierarchy and the `Frames:` and `Frame Time:` lines.
+    fn parse_header(&mut self) -> Result<(Skeleton, MotionHeader)> {
         let joints = self.parse_hierarchy()?;
         let motion_line = self.lines.number;
         let header = self.parse_motion_header()?;
@@ -539,8 +557,7 @@ impl<R: BufRead> Parser<R> {
             self.lines
                 .error(motion_line, 1, format!("invalid hierarchy: {e}"))
         })?;
-        let values = self.parse_frames(skeleton.channel_count(), &header)?;
-        Motion::new(skeleton, header.frame_time, header.frames, values)
+        Ok((skeleton, header))
     }
 
     /// Reads from `HIERARCHY` up to and including `MOTION`; joints in file

@@ -78,6 +78,21 @@ impl MotionSource {
         }
     }
 
+    /// The number of frames and the frame time of the motion, from the
+    /// file's header, without reading the frames, where the format gives
+    /// them there (BVH's `Frames:` and `Frame Time:`); `None` where only
+    /// reading the motion tells (AMC). For refusing a take too long for a
+    /// command before it is read.
+    pub fn announced_length(&self) -> Result<Option<(usize, f64)>> {
+        match self {
+            MotionSource::Bvh(path) => {
+                let (_, frames, frame_time) = bvh::read_bvh_header(path)?;
+                Ok(Some((frames, frame_time)))
+            }
+            MotionSource::AsfAmc { .. } => Ok(None),
+        }
+    }
+
     pub fn read(&self) -> Result<Motion> {
         match self {
             MotionSource::Bvh(path) => bvh::read_bvh(path),
