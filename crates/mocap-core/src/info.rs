@@ -1,6 +1,8 @@
 //! `mocap info`: what a motion file holds (joints, channels, frames, frame
-//! rate, duration, bounding box, the rig its body parts were found by).
+//! rate, duration, bounding box, the rig its body parts were found by, and
+//! how).
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use serde::Serialize;
@@ -26,19 +28,30 @@ pub struct MotionInfo {
     pub bounding_box: Option<[[f32; 3]; 2]>,
     pub root: String,
     pub joint_names: Vec<String>,
-    /// The built-in rig the body parts were found by, `None` when the
-    /// required parts are not found (retargeting and style transfer then
-    /// need a rig file).
+    /// The rig the body parts were found on ([`BodyMap::rig`]: a naming
+    /// convention, a rig file's name, `unnamed` when found by shape), `None`
+    /// when the required parts are not found (retargeting and style transfer
+    /// then need a rig file).
     pub rig: Option<String>,
+    /// How the body parts were found ([`crate::bodymap::FoundBy::key`]): `names`, `shape`,
+    /// `rig_file`; `None` when they are not found.
+    pub found_by: Option<String>,
     /// The body parts found, by key (`pelvis`, `left_clavicle`...).
     pub body_parts: Vec<String>,
+    /// The joint of each body part found, by part key.
+    pub body_part_joints: BTreeMap<String, String>,
+    /// Why the body parts are not found, with a rig-file template to start
+    /// from ([`BodyMap::detect`]'s error); `None` when they are found.
+    pub body_parts_error: Option<String>,
 }
 
 impl MotionInfo {
     /// Describes `motion`, read from the file named `file`.
     pub fn of(file: impl Into<String>, motion: &Motion) -> MotionInfo {
         let skeleton = motion.skeleton();
-        let map = BodyMap::detect(skeleton).ok();
+        let detected = BodyMap::detect(skeleton);
+        let body_parts_error = detected.as_ref().err().map(|e| e.to_string());
+        let map = detected.ok();
         MotionInfo {
             file: file.into(),
             joints: skeleton.joint_count(),
@@ -56,10 +69,17 @@ impl MotionInfo {
                 .unwrap_or_default(),
             joint_names: skeleton.joints().iter().map(|j| j.name.clone()).collect(),
             rig: map.as_ref().map(|m| m.rig().to_string()),
+            found_by: map.as_ref().map(|m| m.found_by().key().to_string()),
             body_parts: map
                 .iter()
                 .flat_map(|m| m.parts().map(|(part, _)| part.key().to_string()))
                 .collect(),
+            body_part_joints: map
+                .iter()
+                .flat_map(|m| m.parts())
+                .map(|(part, joint)| (part.key().to_string(), skeleton.joint(joint).name.clone()))
+                .collect(),
+            body_parts_error,
         }
     }
 
@@ -81,17 +101,42 @@ impl MotionInfo {
                 lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
             );
         }
-        match &self.rig {
-            Some(rig) => {
+        match (&self.rig, &self.body_parts_error) {
+            (Some(rig), _) => {
+                let how = match self.found_by.as_deref() {
+                    Some("names") => ", found by joint name",
+                    Some("shape") => ", found by the skeleton's shape",
+                    Some("rig_file") => ", from a rig file",
+                    _ => "",
+                };
                 s += &format!(
-                    "  rig        {rig} ({} of {} body parts)\n",
+                    "  rig        {rig} ({} of {} body parts{how})\n",
                     self.body_parts.len(),
                     BodyPart::COUNT
-                )
+                );
+                // Parts found by shape: show which joints, to check.
+                if self.found_by.as_deref() == Some("shape") {
+                    let parts: Vec<String> = self
+                        .body_parts
+                        .iter()
+                        .filter_map(|part| {
+                            Some(format!("{part} {}", self.body_part_joints.get(part)?))
+                        })
+                        .collect();
+                    s += &format!("  parts      {}\n", parts.join(", "));
+                }
             }
-            None => s +=
-                "  rig        body parts not found (search, restyling and retargeting need them: \
-                      describe the rig in a file and give it with --rig FILE: docs/rigs.md)\n",
+            (None, error) => {
+                s += "  rig        body parts not found (search, restyling and retargeting need \
+                      them: describe the rig in a file and give it with --rig FILE: \
+                      docs/rigs.md)\n";
+                if let Some(template) = error.as_deref().and_then(|e| e.split_once("\n\n")) {
+                    s += "             a rig file to start from:\n";
+                    for line in template.1.lines() {
+                        s += &format!("               {line}\n");
+                    }
+                }
+            }
         }
         s
     }

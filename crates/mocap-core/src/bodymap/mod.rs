@@ -443,18 +443,7 @@ impl BodyMap {
             });
         }
 
-        // Refused: what was found, by name first, then by shape.
-        let mut found = named.map.joints;
-        for part in BodyPart::ALL {
-            let slot = &mut found[part.index()];
-            if slot.is_none() && !found_elsewhere(&named.map.joints, shape.joints[part.index()]) {
-                *slot = shape.joints[part.index()];
-            }
-        }
-        let sides_unknown = shape.sides.is_none()
-            && BodyPart::ALL.iter().any(|p| {
-                p.side().is_some() && named.map.joint(*p).is_none() && found[p.index()].is_some()
-            });
+        let (found, sides_unknown) = merge_found(&named, &shape);
         let missing: Vec<String> = BodyPart::ALL
             .iter()
             .filter(|p| p.is_required() && found[p.index()].is_none())
@@ -498,6 +487,20 @@ impl BodyMap {
                 .unwrap_or("left and right cannot be told"),
             rig_file::template(skeleton, &found, sides_unknown),
         )))
+    }
+
+    /// A rig file for `skeleton` to start from (the format of
+    /// [`BodyMap::from_toml_str`]): the parts the names or the shape find
+    /// filled in, the others as comments to fill in (the required ones
+    /// marked TODO). This is the template [`BodyMap::detect`]'s error
+    /// carries; on a rig whose parts are found it lists them all.
+    pub fn rig_file_template(skeleton: &Skeleton) -> String {
+        let named = best_rig(&NameIndex::new(skeleton));
+        if named.map.missing().iter().all(|p| !p.is_required()) {
+            return rig_file::template(skeleton, &named.map.joints, false);
+        }
+        let (found, sides_unknown) = merge_found(&named, &shape::find(skeleton));
+        rig_file::template(skeleton, &found, sides_unknown)
     }
 
     /// A map from explicit `(part, joint index)` pairs; parts not listed are
@@ -625,9 +628,10 @@ impl BodyMap {
 
 /// Every left/right joint pair of `skeleton` `(left, right)`, sorted by the
 /// left joint: joints whose names differ only by a side marker (`Left`/
-/// `Right` anywhere in the name, suffixes `_L`/`_R`, `.L`/`.R`, `-L`/`-R`,
-/// prefixes `L_`/`R_`, `L`/`R` before a capital as in CMU's `LHipJoint`, and
-/// `l`/`r` before a lowercase letter as in ASF's `lfemur`), plus the
+/// `Right` anywhere in the name, ` L `/` R ` as in Biped's `Bip01 L Thigh`,
+/// suffixes `_L`/`_R`, `.L`/`.R`, `-L`/`-R`, ` L`/` R`, prefixes `L_`/`R_`,
+/// `L `/`R `, `L`/`R` before a capital as in CMU's `LHipJoint`, and `l`/`r`
+/// before a letter as in ASF's `lfemur` and Daz's `lThigh`), plus the
 /// left/right parts of the detected [`BodyMap`] when detection succeeds.
 pub fn mirror_pairs(skeleton: &Skeleton) -> Vec<(usize, usize)> {
     match BodyMap::detect(skeleton) {
@@ -636,9 +640,24 @@ pub fn mirror_pairs(skeleton: &Skeleton) -> Vec<(usize, usize)> {
     }
 }
 
-/// Whether `joint` already stands for a part in `joints`.
-fn found_elsewhere(joints: &[Option<usize>; BodyPart::COUNT], joint: Option<usize>) -> bool {
-    joint.is_some() && joints.contains(&joint)
+/// The parts found by name (first) and by shape (for the parts the names
+/// miss, with joints the names do not already place), and whether some of
+/// the sided parts come from a shape that could not tell left from right.
+fn merge_found(
+    named: &names::NameMatch,
+    shape: &shape::ShapeOutcome,
+) -> ([Option<usize>; BodyPart::COUNT], bool) {
+    let by_name = &named.map.joints;
+    let mut found = *by_name;
+    let mut guessed_side = false;
+    for part in BodyPart::ALL {
+        let from_shape = shape.joints[part.index()];
+        if found[part.index()].is_none() && from_shape.is_some() && !by_name.contains(&from_shape) {
+            found[part.index()] = from_shape;
+            guessed_side |= part.side().is_some() && shape.sides.is_none();
+        }
+    }
+    (found, guessed_side)
 }
 
 /// The first joint names of a skeleton, for error messages.

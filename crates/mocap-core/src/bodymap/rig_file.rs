@@ -216,10 +216,14 @@ pub(super) fn template(
         };
         let note = match (found[part.index()], part.is_required()) {
             (Some(_), _) => String::new(),
-            (None, true) => format!("  # TODO, required: {}", part.point()),
-            (None, false) => format!("  # optional: {}", part.point()),
+            (None, true) => format!(" # TODO, required: {}", part.point()),
+            (None, false) => format!(" # optional: {}", part.point()),
         };
-        let _ = writeln!(out, "{line}{note}");
+        if note.is_empty() {
+            let _ = writeln!(out, "{line}");
+        } else {
+            let _ = writeln!(out, "{line:<24}{note}");
+        }
     }
     out
 }
