@@ -50,10 +50,16 @@ const CMU_BVH: Rig = Rig {
         (BodyPart::LeftShoulder, &["LeftArm"]),
         (BodyPart::LeftElbow, &["LeftForeArm"]),
         (BodyPart::LeftWrist, &["LeftHand"]),
-        // CMU's `LeftFingerBase` has a zero offset from the wrist.
+        // CMU's `LeftFingerBase` has a zero offset from the wrist; FAIR's
+        // rig (AnimatedDrawings) ends the hand in `LeftHandEnd`.
         (
             BodyPart::LeftHand,
-            &["LeftHandMiddle1", "LeftHandIndex1", "LeftFingerBase"],
+            &[
+                "LeftHandMiddle1",
+                "LeftHandIndex1",
+                "LeftFingerBase",
+                "LeftHandEnd",
+            ],
         ),
         (BodyPart::LeftHip, &["LeftUpLeg"]),
         (BodyPart::LeftKnee, &["LeftLeg"]),
