@@ -41,6 +41,78 @@ fn info_json_reports_the_sample() {
     assert_eq!(parts.len(), 21, "{parts:?}");
     assert!(parts.contains(&serde_json::json!("left_clavicle")));
     assert!(!parts.contains(&serde_json::json!("left_hand")));
+    assert_eq!(first["found_by"], "names");
+    assert_eq!(first["body_part_joints"]["left_shoulder"], "UpperArm_L");
+    assert!(first["body_parts_error"].is_null());
+}
+
+/// A BVH file's text with every joint renamed `j<k>` in file order.
+fn with_meaningless_names(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut k = 0;
+    text.lines()
+        .map(|line| {
+            let trimmed = line.trim_start();
+            for keyword in ["ROOT ", "JOINT "] {
+                if trimmed.starts_with(keyword) {
+                    k += 1;
+                    let indent = &line[..line.len() - trimmed.len()];
+                    return format!("{indent}{keyword}j{k}");
+                }
+            }
+            line.to_string()
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn info_says_how_the_body_parts_were_found() {
+    let Some(data) = shared_data() else { return };
+    let daz = data.join("other-rigs/cmu-daz/02/02_01.bvh");
+    let xia = data.join("other-rigs/xia/neutral_01_000.bvh");
+    let dir = tempfile::tempdir().unwrap();
+    let renamed = dir.path().join("renamed.bvh");
+    std::fs::write(&renamed, with_meaningless_names(&xia)).unwrap();
+    let two_joints = data.join("parser-cases/bvhanim_test_simple.bvh");
+    let files = [&daz, &renamed, &two_joints].map(|p| p.display().to_string());
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+
+    let out = mocap(&[&["info", "--json"], &files[..]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Daz/Poser names.
+    assert_eq!(info[0]["rig"], "Daz/Poser");
+    assert_eq!(info[0]["found_by"], "names");
+    assert_eq!(info[0]["body_part_joints"]["right_hip"], "rThigh");
+    // No name means anything: the shape. In the file, the CMU rig's
+    // `LeftUpLeg` is the third joint and `RightArm` the 26th.
+    assert_eq!(info[1]["rig"], "unnamed");
+    assert_eq!(info[1]["found_by"], "shape");
+    assert_eq!(info[1]["body_part_joints"]["left_hip"], "j3");
+    assert_eq!(info[1]["body_part_joints"]["right_shoulder"], "j26");
+    assert_eq!(info[1]["body_parts"].as_array().unwrap().len(), 23);
+    // No body: refused, with a rig file to start from.
+    assert!(info[2]["rig"].is_null() && info[2]["found_by"].is_null());
+    let error = info[2]["body_parts_error"].as_str().unwrap();
+    assert!(
+        error.contains("--rig FILE") && error.contains("# pelvis = \"\""),
+        "{error}"
+    );
+
+    let out = mocap(&[&["info"], &files[..]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for expected in [
+        "rig        Daz/Poser (21 of 23 body parts, found by joint name)",
+        "rig        unnamed (23 of 23 body parts, found by the skeleton's shape)",
+        "parts      pelvis j1, spine j13,",
+        "body parts not found",
+        "--rig FILE",
+        "# left_hip = \"\"",
+    ] {
+        assert!(text.contains(expected), "{expected}: {text}");
+    }
 }
 
 #[test]
