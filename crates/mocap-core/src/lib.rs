@@ -5,7 +5,8 @@
 //! - [`skeleton`] and [`motion`]: the data model (joints, channels, frames);
 //! - [`rotation`]: every rotation conversion, written once;
 //! - [`kinematics`]: forward kinematics;
-//! - [`bodymap`]: semantic body parts located by joint name, and mirroring;
+//! - [`bodymap`]: semantic body parts located on any humanoid rig (by joint
+//!   name, else by the skeleton's shape, or from a rig file), and mirroring;
 //! - [`ops`]: resample, trim, mirror, scale;
 //! - [`retarget`]: a motion played by another rig of the same body map;
 //! - [`metrics`]: position and rotation errors, bone-length statistics;
