@@ -3,11 +3,10 @@
 //! in 0-10 degrees, seeded per take:
 //!
 //! - `RIG.bvh`: each take played by another rig (the rig of the file; the
-//!   take's first frame and the file's as reference poses), the noise added
+//!   rigs in their canonical T-poses), the noise added
 //!   on that rig, and cleaned there by the cross-validated and the 2 Hz
 //!   Butterworth, or by the shipped model through retargeting: played by
-//!   the Bandai rig (the noisy take's first frame and the bundled walk's as
-//!   reference poses), cleaned, played back onto the noisy take
+//!   the Bandai rig, cleaned, played back onto the noisy take
 //!   (`Retargeting::apply_onto`: joints the Bandai rig lacks stay as they
 //!   were). Also the clean takes through the model (how far it moves a
 //!   clean take). Errors over every joint with rotation channels and over
@@ -56,7 +55,7 @@ fn main() -> Result<(), Error> {
     // The take as the experiment gives it: on the other rig, or resampled.
     let given = |m: &Motion| -> Result<Motion, Error> {
         Ok(match (&rig, fps) {
-            (Some(rig), _) => Retargeting::detect(m, rig)?.apply(m)?,
+            (Some(rig), _) => Retargeting::detect(m.skeleton(), rig.skeleton())?.apply(m)?,
             (None, Some(fps)) => resample_fps(m, fps)?,
             _ => unreachable!(),
         })
@@ -65,9 +64,9 @@ fn main() -> Result<(), Error> {
     let through_model = |m: &Motion| -> Result<Motion, Error> {
         Ok(match &rig {
             Some(_) => {
-                let on_bandai = Retargeting::detect(m, &bandai)?.apply(m)?;
+                let on_bandai = Retargeting::detect(m.skeleton(), bandai.skeleton())?.apply(m)?;
                 let cleaned = model.clean(&on_bandai, None)?.0;
-                Retargeting::detect(&bandai, m)?.apply_onto(&cleaned, m)?
+                Retargeting::detect(bandai.skeleton(), m.skeleton())?.apply_onto(&cleaned, m)?
             }
             None => model.clean(m, None)?.0,
         })

@@ -8,8 +8,8 @@
 //! cargo run --release -p mocap-core --example retarget_check -- DATA_FOLDER RIG.bvh...
 //!
 //! With `--plausibility REFERENCE.bvh CLIP.bvh...`: clips of other rigs
-//! played by the reference's rig (reference poses: both first frames, and
-//! both rest poses), and for each clip the mean angle between every joint's
+//! played by the reference's rig (reference poses: both canonical T-poses,
+//! both first frames, and both rest poses), and for each clip the mean angle between every joint's
 //! local rotation and the reference's mean local rotation of that joint;
 //! clips of the reference's own rig are measured as they are, for scale.
 
@@ -23,6 +23,17 @@ use mocap_core::metrics::largest_bone_angle_degrees;
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, mean_of_close, Quat};
 use mocap_core::{forward_kinematics, Motion};
+
+/// A retargeting with the first frames of `source` and `target` as the
+/// reference poses.
+fn by_references(source: &Motion, target: &Motion) -> mocap_core::Result<Retargeting> {
+    Retargeting::with_reference_poses(
+        source,
+        &BodyMap::detect(source.skeleton())?,
+        target,
+        &BodyMap::detect(target.skeleton())?,
+    )
+}
 
 /// See the module docs (`--plausibility`).
 fn plausibility(reference: &Path, clips: &[PathBuf]) -> Result<(), Box<dyn std::error::Error>> {
@@ -56,19 +67,23 @@ fn plausibility(reference: &Path, clips: &[PathBuf]) -> Result<(), Box<dyn std::
             vec![
                 ("(same rig, as captured)", clip.clone()),
                 (
-                    "first frames",
-                    Retargeting::detect(&clip, &reference)?.apply(&clip)?,
+                    "canonical poses",
+                    Retargeting::detect(clip.skeleton(), reference.skeleton())?.apply(&clip)?,
                 ),
             ]
         } else {
             vec![
                 (
+                    "canonical poses",
+                    Retargeting::detect(clip.skeleton(), reference.skeleton())?.apply(&clip)?,
+                ),
+                (
                     "first frames",
-                    Retargeting::detect(&clip, &reference)?.apply(&clip)?,
+                    by_references(&clip, &reference)?.apply(&clip)?,
                 ),
                 (
                     "rest poses",
-                    Retargeting::detect(&rest(&clip)?, &rest(&reference)?)?.apply(&clip)?,
+                    by_references(&rest(&clip)?, &rest(&reference)?)?.apply(&clip)?,
                 ),
             ]
         };
@@ -133,8 +148,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut rotation_sums: Vec<f64> = Vec::new();
         for take in &takes {
             let t = Instant::now();
-            let there = Retargeting::detect(take, &other)?;
-            let back = Retargeting::detect(&other, take)?;
+            let there = Retargeting::detect(take.skeleton(), other.skeleton())?;
+            let back = Retargeting::detect(other.skeleton(), take.skeleton())?;
             let moved = there.apply(take)?;
             let returned = back.apply(&moved)?;
             seconds += t.elapsed().as_secs_f64();

@@ -60,7 +60,7 @@ pub fn convert_files(inputs: &[PathBuf], options: &ConvertOptions) -> Result<Mot
     }
     if let Some(rig) = &options.retarget_to {
         let target = io::bvh::read_bvh(rig)?;
-        motion = Retargeting::detect(&motion, &target)
+        motion = Retargeting::detect(motion.skeleton(), target.skeleton())
             .and_then(|r| r.apply(&motion))
             .map_err(|e| {
                 Error::Invalid(format!(

@@ -22,14 +22,20 @@
 //! joint's own axes, so (1) gives the target's bone the source's bone frame:
 //! bones keep their directions whatever the rigs' joint axes.
 //!
-//! The reference pose of a rig is the first frame of a motion of it
-//! ([`Retargeting::new`]): the frames `F` are only comparable between poses
-//! where limbs twist alike, which natural poses (standing, walking, a
-//! T-pose) do. The rest pose (every rotation zero, [`Motion::rest`]) is one
-//! only for rigs built so: CMU's and Mixamo's rest in a T-pose, but
-//! Bandai's rest has every bone along x, legs included, and local rotations
-//! retargeted with it are valid but turned far from any Bandai capture
-//! (bench/results/retarget.md). A retargeting there and back with the same
+//! The reference pose of a rig is its [`canonical_pose`], a T-pose made
+//! from the rig alone ([`Retargeting::new`]), so a motion retargets the same
+//! wherever it starts. The frames `F` are only comparable between poses
+//! where limbs twist alike: the canonical pose swings each body part's bone
+//! from the rest pose (every rotation zero, [`Motion::rest`]) onto its
+//! T-pose direction, which keeps the twist the rig's rest has. That is the
+//! anatomical twist for rigs built so (CMU's and Mixamo's rest in a T-pose,
+//! others in an A-pose), but Bandai's rest has every bone along x and joint
+//! axes half a turn about some bones from where captures hold them: its
+//! canonical pose starts from a natural pose of it instead. Local rotations
+//! retargeted onto Bandai from the bare rest poses are valid but turned far
+//! from any Bandai capture (bench/results/retarget.md). Other reference
+//! poses can be given ([`Retargeting::with_reference_poses`], e.g. a T-pose
+//! frame captured on each rig). A retargeting there and back with the same
 //! two references gives the motion back exactly. Two rigs with the same
 //! joints (names, hierarchy and bone directions; other bone lengths, as two
 //! performers of one capture setup) need no convention: every joint keeps
@@ -197,12 +203,12 @@ impl<'a> ReferenceRig<'a> {
         ]
         .into_iter()
         .find_map(|p| map.joint(p))
-        .ok_or_else(|| Error::Invalid(format!("the {what} rig has no spine or head")))?;
+        .ok_or_else(|| Error::Invalid(format!("{what} has no spine or head")))?;
         let up = rig.toward(pelvis, top) - rig.positions[pelvis];
         let up = (up - up.dot(rig.lateral) * rig.lateral).normalize_or_zero();
         if rig.lateral == Vec3::ZERO || up == Vec3::ZERO {
             return Err(Error::Invalid(format!(
-                "the {what} rig's reference pose has its hips at one point or its spine along the hips: \
+                "{what}'s reference pose has its hips at one point or its spine along the hips: \
                  cannot tell its body axes"
             )));
         }
@@ -273,22 +279,170 @@ impl<'a> ReferenceRig<'a> {
     }
 }
 
+/// The direction a part's bone takes in the canonical T-pose, in the body's
+/// axes (left-right `lateral`, `up`, `forward`): up for the spine and neck,
+/// sideways for a clavicle and an arm, down for a leg, forward for a foot.
+/// The pelvis and the parts without a bone have none: the pelvis stays as
+/// the rig has it (it carries the body's axes), the others follow.
+fn canonical_direction(part: BodyPart, lateral: Vec3, up: Vec3, forward: Vec3) -> Option<Vec3> {
+    use BodyPart::*;
+    match part {
+        Pelvis | Head | LeftHand | RightHand | LeftToe | RightToe => None,
+        Spine | Chest | Neck => Some(up),
+        LeftClavicle | LeftShoulder | LeftElbow | LeftWrist => Some(lateral),
+        RightClavicle | RightShoulder | RightElbow | RightWrist => Some(-lateral),
+        LeftHip | LeftKnee | RightHip | RightKnee => Some(-up),
+        LeftAnkle | RightAnkle => Some(forward),
+    }
+}
+
+/// The rotation that swings `from` onto `to` (unit vectors) the shortest
+/// way; where they are opposite, half a turn about `axis` (a bone pointing
+/// the wrong way along the body, as a leg of a rest pose with every bone
+/// along one axis: the shortest way is then any, and the body's own axis
+/// keeps the twist the same for every rig).
+fn swing(from: Vec3, to: Vec3, axis: Vec3) -> Quat {
+    if from.dot(to) < -0.9999 {
+        Quat::from_axis_angle(axis, std::f32::consts::PI)
+    } else {
+        Quat::from_rotation_arc(from, to)
+    }
+}
+
+/// Bandai's rig in a natural pose: the local rotations (quaternions x, y,
+/// z, w) of the first frame of the bundled walk
+/// (`samples/dataset-1_walk_normal_001.bvh`; a test checks them against
+/// it). Bandai's rest pose has every bone along x and its joints' axes
+/// turned about their bones in no anatomical way (its right thigh is half
+/// a turn about the bone from where captures hold it), so no rest-pose rule
+/// can tell how the rig's limbs twist: its canonical pose starts from this
+/// one instead.
+const BANDAI_STANDING: [(&str, [f32; 4]); 21] = [
+    ("Hips", [0.0172, 0.0026, 0.6849, 0.7284]),
+    ("Spine", [0.7160, -0.0072, 0.0173, 0.6979]),
+    ("Chest", [0.0255, 0.0143, -0.0331, 0.9990]),
+    ("Neck", [-0.0196, -0.0131, -0.0578, 0.9980]),
+    ("Head", [-0.0551, -0.0065, 0.0410, 0.9976]),
+    ("Shoulder_L", [-0.5033, -0.5141, -0.5001, 0.4820]),
+    ("UpperArm_L", [-0.0957, 0.2260, -0.5729, 0.7820]),
+    ("LowerArm_L", [0.0602, -0.1254, 0.0076, 0.9902]),
+    ("Hand_L", [0.0443, 0.0147, 0.1474, 0.9880]),
+    ("Shoulder_R", [0.5353, -0.5054, 0.4544, 0.5015]),
+    ("UpperArm_R", [-0.0543, 0.1209, -0.5562, 0.8204]),
+    ("LowerArm_R", [0.0652, -0.1673, 0.0111, 0.9837]),
+    ("Hand_R", [0.0549, -0.0330, 0.1892, 0.9798]),
+    ("UpperLeg_L", [-0.2049, -0.0295, -0.9781, 0.0203]),
+    ("LowerLeg_L", [0.0030, 0.5904, -0.0023, 0.8071]),
+    ("Foot_L", [-0.0538, -0.3646, 0.0691, 0.9270]),
+    ("Toes_L", [-0.0037, -0.1855, 0.0044, 0.9826]),
+    ("UpperLeg_R", [0.9895, 0.0880, -0.1140, 0.0089]),
+    ("LowerLeg_R", [-0.0000, 0.2564, 0.0003, 0.9666]),
+    ("Foot_R", [-0.0854, -0.5608, 0.0922, 0.8184]),
+    ("Toes_R", [0.0003, -0.1441, -0.0006, 0.9896]),
+];
+
+/// The name [`BodyMap::rig`] gives Bandai's rig.
+const BANDAI_RIG: &str = "Bandai Namco";
+
+/// The rig of `skeleton` in the canonical T-pose, one frame: from its rest
+/// pose (every rotation zero; for Bandai's rig, a natural pose of it,
+/// [`BANDAI_STANDING`]), each body part's bone swung, parents first,
+/// the shortest way onto its direction in a T-pose ([`canonical_direction`])
+/// in the body's axes of the rest pose (left-right from the hips, up from
+/// the pelvis to the top of the spine). A rig whose rest pose is a T-pose
+/// (CMU, Mixamo) stays as it is; an A-pose has its arms raised; a rest pose
+/// with every bone along one axis (Bandai's) is stood up. Only the bones'
+/// directions decide, so every motion of a rig has the same reference pose
+/// for (1), wherever the motion starts. Joints of no part keep their rest
+/// rotation, and a joint without rotation channels cannot turn.
+pub fn canonical_pose(skeleton: &Skeleton, map: &BodyMap) -> Result<Motion> {
+    let mut pose = Motion::rest(skeleton.clone(), 1.0 / 30.0, 1)?;
+    if map.rig() == BANDAI_RIG {
+        for (name, [x, y, z, w]) in BANDAI_STANDING {
+            if let Some(j) = skeleton.find(name) {
+                pose.set_local_rotation(0, j, Quat::from_xyzw(x, y, z, w).normalize());
+            }
+        }
+    }
+    let rest = ReferenceRig::new(&pose, map, "the rig")?;
+    let (lateral, forward) = (rest.lateral, rest.forward);
+    let up = forward.cross(lateral).normalize();
+    let mut parts: Vec<(usize, BodyPart)> = map.parts().map(|(p, j)| (j, p)).collect();
+    parts.sort_by_key(|&(j, _)| j); // parents before children
+    for (joint, part) in parts {
+        let Some(direction) = canonical_direction(part, lateral, up, forward) else {
+            continue;
+        };
+        let Some(below) = bone_candidates(part).iter().find_map(|&p| map.joint(p)) else {
+            continue;
+        };
+        if !skeleton.joint(joint).has_rotation_channels() {
+            continue;
+        }
+        let poses = forward_kinematics(&pose);
+        let bone = poses.position(0, below) - poses.position(0, joint);
+        if bone.length() < 1e-6 {
+            continue;
+        }
+        // Arms and the spine turn in the body's frontal plane, legs and feet
+        // in its sagittal plane, when half a turn is needed.
+        let axis = if matches!(
+            part,
+            BodyPart::LeftAnkle
+                | BodyPart::RightAnkle
+                | BodyPart::LeftHip
+                | BodyPart::RightHip
+                | BodyPart::LeftKnee
+                | BodyPart::RightKnee
+        ) {
+            lateral
+        } else {
+            forward
+        };
+        let turn = swing(bone.normalize(), direction, axis);
+        let global = turn * poses.rotation(0, joint);
+        let parent = skeleton
+            .joint(joint)
+            .parent
+            .map_or(Quat::IDENTITY, |p| poses.rotation(0, p));
+        pose.set_local_rotation(0, joint, (parent.inverse() * global).normalize());
+    }
+    Ok(pose)
+}
+
 impl Retargeting {
-    /// Prepares retargeting from the rig of `source_reference` to the rig of
-    /// `target_reference`, located by their body maps; the first frame of
-    /// each is its rig's reference pose `F` of (1) is measured in (its rest
-    /// pose when it has no frame; give `Motion::rest` for the rest pose
-    /// anyway; see the module docs on choosing). Fails when a rig's body
-    /// axes cannot be told.
+    /// Prepares retargeting from the rig of `source` to the rig of `target`,
+    /// located by their body maps, each in its [`canonical_pose`] as the
+    /// reference pose of (1): a motion retargets the same wherever it
+    /// starts. Fails when a rig's body axes cannot be told from its rest
+    /// pose.
     pub fn new(
+        source: &Skeleton,
+        source_map: &BodyMap,
+        target: &Skeleton,
+        target_map: &BodyMap,
+    ) -> Result<Retargeting> {
+        Retargeting::with_reference_poses(
+            &canonical_pose(source, source_map)?,
+            source_map,
+            &canonical_pose(target, target_map)?,
+            target_map,
+        )
+    }
+
+    /// [`Retargeting::new`] with given reference poses: the first frame of
+    /// each motion (its rest pose when it has no frame), e.g. a frame where
+    /// the performer stood in a T-pose on each rig. Both poses must twist
+    /// their limbs alike (see the module docs).
+    pub fn with_reference_poses(
         source_reference: &Motion,
         source_map: &BodyMap,
         target_reference: &Motion,
         target_map: &BodyMap,
     ) -> Result<Retargeting> {
         let (source, target) = (source_reference.skeleton(), target_reference.skeleton());
-        let reference_s = ReferenceRig::new(source_reference, source_map, "source")?;
-        let reference_t = ReferenceRig::new(target_reference, target_map, "target")?;
+        let reference_s = ReferenceRig::new(source_reference, source_map, "the source rig")?;
+        let reference_t = ReferenceRig::new(target_reference, target_map, "the target rig")?;
         let (leg_s, leg_t) = (
             source_map.leg_length(source)?,
             target_map.leg_length(target)?,
@@ -359,12 +513,12 @@ impl Retargeting {
 
     /// [`Retargeting::new`] for two rigs whose body maps the built-in rig
     /// tables find ([`BodyMap::detect`]).
-    pub fn detect(source_reference: &Motion, target_reference: &Motion) -> Result<Retargeting> {
-        let source_map = BodyMap::detect(source_reference.skeleton())
-            .map_err(|e| Error::Invalid(format!("the source rig: {e}")))?;
-        let target_map = BodyMap::detect(target_reference.skeleton())
-            .map_err(|e| Error::Invalid(format!("the target rig: {e}")))?;
-        Retargeting::new(source_reference, &source_map, target_reference, &target_map)
+    pub fn detect(source: &Skeleton, target: &Skeleton) -> Result<Retargeting> {
+        let source_map =
+            BodyMap::detect(source).map_err(|e| Error::Invalid(format!("the source rig: {e}")))?;
+        let target_map =
+            BodyMap::detect(target).map_err(|e| Error::Invalid(format!("the target rig: {e}")))?;
+        Retargeting::new(source, &source_map, target, &target_map)
     }
 
     /// Target leg length over source leg length: how root translations are
@@ -593,4 +747,24 @@ fn depth(skeleton: &Skeleton, joint: usize) -> usize {
         j = p;
     }
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bandais_standing_pose_is_the_bundled_walks_first_frame() {
+        let walk = crate::io::bvh::read_bvh(&mocap_testdata::sample_walk()).unwrap();
+        for (name, [x, y, z, w]) in BANDAI_STANDING {
+            let j = walk.skeleton().find(name).unwrap();
+            let q = Quat::from_xyzw(x, y, z, w).normalize();
+            let angle = crate::rotation::angle_between(q, walk.local_rotation(0, j));
+            assert!(
+                angle.to_degrees() < 0.05,
+                "{name}: {} deg",
+                angle.to_degrees()
+            );
+        }
+    }
 }

@@ -549,7 +549,7 @@ fn retargeting(from: &Motion, to: &Motion) -> mocap_core::Result<Retargeting> {
     };
     let from_map = found(from.skeleton(), "this clip's")?;
     let to_map = found(to.skeleton(), "the other clip's")?;
-    Retargeting::new(from, &from_map, to, &to_map)
+    Retargeting::new(from.skeleton(), &from_map, to.skeleton(), &to_map)
 }
 
 /// The longest source [`apply`] restyles, in seconds: an hour. A restyle

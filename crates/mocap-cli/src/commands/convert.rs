@@ -32,8 +32,8 @@ pub struct Args {
     #[arg(long, value_name = "A..B")]
     frames: Option<FrameRange>,
     /// Play the motion on the rig of this BVH file: body parts matched by joint name, bone
-    /// directions kept, strides scaled by the legs' lengths. The first frames of the input and
-    /// of this file are the two rigs' reference poses (best both standing or both T-poses).
+    /// directions kept, strides scaled by the legs' lengths. Each rig is related to one T-pose
+    /// from its rest pose, so the result does not depend on where the input starts.
     #[arg(long, value_name = "RIG.bvh")]
     retarget_to: Option<PathBuf>,
 }
