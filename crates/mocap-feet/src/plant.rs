@@ -17,7 +17,7 @@
 //!    Hermite curve that meets the correction's position and speed, so the
 //!    foot gains no jerk where it lands or lifts off).
 //! 3. Per frame, the foot is lifted by the deepest of its joints below its
-//!    resting height on the floor, beyond [`crate::BELOW_FLOOR_TOLERANCE`] (a running maximum, smoothed within it,
+//!    resting height on the floor, beyond half [`crate::BELOW_FLOOR_TOLERANCE`] (a running maximum, smoothed within it,
 //!    so the lift is never less than needed and changes smoothly).
 //! 4. Where a foot's target is further from its hip than the leg reaches
 //!    ([`FeetOptions::reach`] of the leg, or the input's own stretch when
@@ -127,8 +127,9 @@ pub fn plant_feet(
     let ease = ((options.ease_seconds * fps).round() as usize).max(1);
     let keep_step = options.keep_speed * leg_length / fps;
     let before = measure_poses(&take.poses, &take.rig, &take.floor, fps)?;
-    // A foot within the tolerance of the floor is on it, not below.
-    let tolerance = BELOW_FLOOR_TOLERANCE * leg_length;
+    // A foot within the tolerance of the floor is on it, not below; one
+    // deeper is lifted to half the tolerance, clear of it.
+    let tolerance = 0.5 * BELOW_FLOOR_TOLERANCE * leg_length;
 
     // Per foot: the ankle's target shift.
     let mut feet = [FootReport::default(), FootReport::default()];
@@ -452,4 +453,36 @@ fn turn_leg(motion: &mut Motion, poses: &GlobalPoses, f: usize, leg: &Leg, hip: 
     motion.set_local_rotation(f, h, hip_local.normalize());
     motion.set_local_rotation(f, k, knee_local.normalize());
     motion.set_local_rotation(f, a, ankle_local.normalize());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoothing_above_never_goes_below() {
+        let values = [0.0, 0.0, 3.0, 0.0, 1.0, 5.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let smooth = smooth_above(&values, 2);
+        for (v, s) in values.iter().zip(&smooth) {
+            assert!(s >= v, "{values:?} -> {smooth:?}");
+        }
+        // It spreads at most twice the radius.
+        assert_eq!(smooth.last(), Some(&0.0));
+    }
+
+    #[test]
+    fn a_blend_meets_both_ends_in_place_and_speed() {
+        let mut offset = vec![Vec3::ZERO; 21];
+        let (a, va) = (Vec3::new(2.0, 0.0, 0.0), Vec3::new(-0.5, 0.0, 0.0));
+        let (b, vb) = (Vec3::new(-1.0, 0.0, 1.0), Vec3::new(0.2, 0.0, 0.0));
+        offset[0] = a;
+        offset[20] = b;
+        blend(&mut offset, (0, a, va), (20, b, vb));
+        // Speeds at the ends are the given ones (to first order).
+        assert!(((offset[1] - offset[0]) - va).length() < 0.05);
+        assert!(((offset[20] - offset[19]) - vb).length() < 0.05);
+        // Acceleration near the ends is small.
+        let acc = offset[2] - 2.0 * offset[1] + offset[0];
+        assert!(acc.length() < 0.05, "{acc:?}");
+    }
 }
