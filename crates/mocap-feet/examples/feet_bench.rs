@@ -15,7 +15,7 @@
 use std::path::PathBuf;
 
 use mocap_core::bodymap::BodyMap;
-use mocap_core::io::{find_bvh_files, read_motion};
+use mocap_core::io::{find_files, read_motion};
 use mocap_core::metrics::up_axis;
 use mocap_core::rotation::Vec3;
 use mocap_core::{forward_kinematics, Motion};
@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             _ => inputs.push(PathBuf::from(a)),
         }
     }
-    let files = find_bvh_files(&inputs)?;
+    let files = find_files(&inputs, &["bvh", "amc"])?;
     println!(
         "| clip | frames | contacts L/R | sliding before → after (% leg/s) | below floor: frames, deepest (% leg) before → after | jitter before → after | largest move (% leg) | root lowered: frames, most (% leg) |"
     );

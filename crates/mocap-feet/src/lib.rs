@@ -16,7 +16,8 @@
 //!   ([`plant_feet`], [`FeetOptions`]);
 //! - the result is measured before and after on the input's floor:
 //!   planted-foot sliding, feet below the floor, jitter ([`FeetMeasures`],
-//!   from [`mocap_core::metrics`]).
+//!   from [`mocap_core::metrics`]);
+//! - [`plant_feet_file`]: the stage from file to file (`mocap feet`).
 //!
 //! ```no_run
 //! use mocap_core::bodymap::BodyMap;
@@ -32,11 +33,13 @@
 //! ```
 
 mod contacts;
+mod file;
 mod floor;
 mod ground;
 mod plant;
 
 pub use contacts::{ContactOptions, FLOOR_QUANTILE};
+pub use file::{plant_feet_file, FeetFileReport};
 pub use floor::{
     estimate_floor, measure_feet, FeetMeasures, Floor, BELOW_FLOOR_TOLERANCE, MIN_FRAMES,
 };

@@ -461,7 +461,9 @@ mod tests {
 
     #[test]
     fn smoothing_above_never_goes_below() {
-        let values = [0.0, 0.0, 3.0, 0.0, 1.0, 5.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let values = [
+            0.0, 0.0, 3.0, 0.0, 1.0, 5.0, 5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        ];
         let smooth = smooth_above(&values, 2);
         for (v, s) in values.iter().zip(&smooth) {
             assert!(s >= v, "{values:?} -> {smooth:?}");
