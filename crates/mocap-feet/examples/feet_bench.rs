@@ -84,7 +84,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 sums[3] += r.after.jitter as f64 / leg;
                 count += 1;
             }
-            Err(e) => println!("| {name} | – | not measured: {e} | | | | | |"),
+            Err(e) => {
+                // The first clause says why (the body parts are not found...).
+                let e = e.to_string();
+                let why = e.split(": the closest").next().unwrap_or(&e);
+                println!("| {name} | – | not measured: {why} | | | | | |")
+            }
         }
     }
     if count > 0 {

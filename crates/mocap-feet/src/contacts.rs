@@ -8,7 +8,7 @@
 //! faster than [`ContactOptions::leave_speed`]. A foot is in contact while
 //! either of its joints is (the heel strikes, the foot rolls onto the ball,
 //! the heel lifts while the toe still pivots); contacts shorter than
-//! [`ContactOptions::min_frames`] are a foot brushing the ground and are
+//! [`ContactOptions::min_seconds`] are a foot brushing the ground and are
 //! dropped. Lengths are fractions of the leg length and speeds leg lengths
 //! per second, so the same settings hold for every rig and unit.
 //!
@@ -39,8 +39,8 @@ pub struct ContactOptions {
     pub enter_speed: f32,
     /// ... and lifts off above this one (more than `enter_speed`).
     pub leave_speed: f32,
-    /// Contacts of fewer frames are dropped.
-    pub min_frames: usize,
+    /// Contacts shorter than this (seconds) are dropped.
+    pub min_seconds: f32,
 }
 
 impl Default for ContactOptions {
@@ -50,7 +50,7 @@ impl Default for ContactOptions {
             leave_height: 0.07,
             enter_speed: 0.6,
             leave_speed: 1.0,
-            min_frames: 3,
+            min_seconds: 0.1,
         }
     }
 }
@@ -89,7 +89,11 @@ pub fn joint_contacts(
 
 /// The stretches of frames where any of `joints` is on the ground, the
 /// ones of fewer than `min_frames` frames dropped.
-pub fn foot_contacts(joints: &[Vec<bool>], frames: usize, min_frames: usize) -> Vec<Range<usize>> {
+pub(crate) fn foot_contacts(
+    joints: &[Vec<bool>],
+    frames: usize,
+    min_frames: usize,
+) -> Vec<Range<usize>> {
     let on = |f: usize| joints.iter().any(|c| c[f]);
     let mut spans = Vec::new();
     let mut f = 0;

@@ -75,12 +75,13 @@ impl TakeFeet {
         floor: Option<f32>,
     ) -> Result<TakeFeet> {
         let rig = FeetRig::new(motion, map)?;
-        let needed = MIN_FRAMES.max(options.min_frames);
+        let min_frames = ((options.min_seconds * motion.fps() as f32).round() as usize).max(2);
+        let needed = MIN_FRAMES.max(min_frames);
         if motion.frame_count() < needed {
             return Err(Error::Invalid(format!(
                 "the feet stage needs at least {needed} frames (contacts of {} frames or \
                  more, speeds from a frame on each side); this take has {}",
-                options.min_frames,
+                min_frames,
                 motion.frame_count()
             )));
         }
@@ -102,7 +103,7 @@ impl TakeFeet {
                     joint_contacts(t, ground, leg, options)
                 })
                 .collect();
-            spans[side] = foot_contacts(&on, n, options.min_frames);
+            spans[side] = foot_contacts(&on, n, min_frames);
             let mut within = vec![false; n];
             for s in &spans[side] {
                 within[s.clone()].fill(true);

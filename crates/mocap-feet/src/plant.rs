@@ -9,7 +9,8 @@
 //!    median of the steps around it inside the contact (a real foot moves
 //!    as it lands and lifts off, a sliding one all along), less
 //!    [`FeetOptions::keep_speed`] (a real planted foot's few centimetres a
-//!    second are kept). The corrections are summed and centred on the
+//!    second are kept). The corrections are summed, smoothed at high frame
+//!    rates (a gaussian of 33 ms) and centred on the
 //!    contact (the foot held where it was on average), and eased in before
 //!    and out after the contact over [`FeetOptions::ease_seconds`]
 //!    (between two contacts closer than two eases, one blend from the
@@ -38,6 +39,10 @@ use serde::{Deserialize, Serialize};
 use crate::contacts::ContactOptions;
 use crate::floor::{measure_poses, FeetMeasures, TakeFeet, BELOW_FLOOR_TOLERANCE};
 use crate::ground::Leg;
+
+/// The radius of the running maximum and average that smooth the lift
+/// out of the floor (seconds).
+const LIFT_SMOOTHING_SECONDS: f32 = 0.067;
 
 /// Settings of [`plant_feet`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -146,7 +151,11 @@ pub fn plant_feet(
                     - tolerance
             })
             .collect();
-        let lift = smooth_above(&raw_lift.iter().map(|&l| l.max(0.0)).collect::<Vec<_>>(), 2);
+        let lift_radius = ((LIFT_SMOOTHING_SECONDS * fps).round() as usize).max(1);
+        let lift = smooth_above(
+            &raw_lift.iter().map(|&l| l.max(0.0)).collect::<Vec<_>>(),
+            lift_radius,
+        );
         for f in 0..n {
             shifts[side][f] = horizontal[f] + up * lift[f];
         }
@@ -255,6 +264,8 @@ fn pin_offsets(take: &TakeFeet, side: usize, leg: &Leg, keep_step: f32, ease: us
     let on = &take.joint_on[side];
     let mut offset = vec![Vec3::ZERO; n];
     let spans = &take.spans[side];
+    let frames = |seconds: f32| (seconds * take.fps).round() as usize;
+    let (edge, radius) = (frames(CONTACT_EDGE_SECONDS), frames(STEP_MEDIAN_SECONDS));
     for span in spans {
         // The pivot's step into each frame after the first.
         let steps: Vec<Vec3> = (span.start + 1..span.end)
@@ -274,13 +285,14 @@ fn pin_offsets(take: &TakeFeet, side: usize, leg: &Leg, keep_step: f32, ease: us
         let mut held = Vec::with_capacity(span.len());
         held.push(d);
         for i in 0..steps.len() {
-            let step = robust_step(&steps, i);
+            let step = robust_step(&steps, i, edge, radius);
             let length = step.length();
             if length > keep_step {
                 d -= step * (1.0 - keep_step / length);
             }
             held.push(d);
         }
+        let held = gaussian(&held, HELD_SMOOTHING_SECONDS * take.fps);
         let mean = held.iter().fold(Vec3::ZERO, |s, &v| s + v) / held.len() as f32;
         for (f, v) in span.clone().zip(held) {
             offset[f] = v - mean;
@@ -340,6 +352,35 @@ fn pin_offsets(take: &TakeFeet, side: usize, leg: &Leg, keep_step: f32, ease: us
     offset
 }
 
+/// Gaussian smoothing (standard deviation `sigma` frames) of `values`, the
+/// kernel cut at 3 sigma and renormalised at the ends; none below 1.5
+/// frames (at 30 fps the median of the steps is smooth enough, and more
+/// smoothing leaves a dragged foot sliding).
+fn gaussian(values: &[Vec3], sigma: f32) -> Vec<Vec3> {
+    if sigma < 1.5 {
+        return values.to_vec();
+    }
+    let reach = (3.0 * sigma).ceil() as usize;
+    let n = values.len();
+    (0..n)
+        .map(|f| {
+            let (mut sum, mut weight) = (Vec3::ZERO, 0.0);
+            for (g, &v) in values
+                .iter()
+                .enumerate()
+                .take((f + reach + 1).min(n))
+                .skip(f.saturating_sub(reach))
+            {
+                let d = g as f32 - f as f32;
+                let w = (-d * d / (2.0 * sigma * sigma)).exp();
+                sum += v * w;
+                weight += w;
+            }
+            sum / weight
+        })
+        .collect()
+}
+
 /// Fills the frames strictly between `a.0` and `b.0` of `offset` with the
 /// quintic Hermite curve from position `a.1` with velocity `a.2` (per frame)
 /// to `b.1` with velocity `b.2`, accelerations zero at both ends. Frames
@@ -361,25 +402,29 @@ fn blend(offset: &mut [Vec3], a: (usize, Vec3, Vec3), b: (usize, Vec3, Vec3)) {
 /// Frames at each end of a contact whose steps are not trusted (a foot
 /// landing or lifting off moves while it is already, or still, low and
 /// slow), and frames each side of a step whose median stands for it.
-const CONTACT_EDGE: usize = 2;
-const STEP_MEDIAN_RADIUS: usize = 3;
+const CONTACT_EDGE_SECONDS: f32 = 0.067;
+const STEP_MEDIAN_SECONDS: f32 = 0.1;
+
+/// Standard deviation of the gaussian that smooths a contact's summed
+/// correction (seconds): the steps carry the capture's noise, which a high
+/// frame rate makes larger against the kept speed.
+const HELD_SMOOTHING_SECONDS: f32 = 0.033;
 
 /// The step of a contact's pivot into frame `i + 1` as the stage corrects
 /// it: the median (per coordinate) of the steps within
-/// [`STEP_MEDIAN_RADIUS`] of it, among the contact's inner steps (not the
-/// [`CONTACT_EDGE`] first and last; a step near an end takes the nearest
+/// [`STEP_MEDIAN_SECONDS`] of it (`radius` frames), among the contact's inner steps (not the
+/// [`CONTACT_EDGE_SECONDS`] first and last, `edge` frames; a step near an end takes the nearest
 /// inner ones). A planted foot that slides slides over the whole contact;
 /// a real one moves only as it lands and lifts off.
-fn robust_step(steps: &[Vec3], i: usize) -> Vec3 {
+fn robust_step(steps: &[Vec3], i: usize, edge: usize, radius: usize) -> Vec3 {
     let n = steps.len();
-    let (lo, hi) = if n > 2 * CONTACT_EDGE + 1 {
-        (CONTACT_EDGE, n - CONTACT_EDGE)
+    let (lo, hi) = if n > 2 * edge + 1 {
+        (edge, n - edge)
     } else {
         (0, n)
     };
     let centre = i.clamp(lo, hi - 1);
-    let window = &steps[centre.saturating_sub(STEP_MEDIAN_RADIUS).max(lo)
-        ..(centre + STEP_MEDIAN_RADIUS + 1).min(hi)];
+    let window = &steps[centre.saturating_sub(radius).max(lo)..(centre + radius + 1).min(hi)];
     let median = |axis: usize| {
         let mut v: Vec<f32> = window.iter().map(|s| s[axis]).collect();
         v.sort_by(|a, b| a.total_cmp(b));
