@@ -41,6 +41,8 @@ enum Command {
     Fuse(commands::fuse::Args),
     /// Denoise a take (learned model or classical filter); train and evaluate denoisers.
     Clean(Box<commands::clean::Args>),
+    /// Keep planted feet still and above the floor: contacts found, legs turned by two-bone IK.
+    Feet(commands::feet::Args),
     /// Motion retrieval by example: index a labelled library, query it, evaluate.
     Search(commands::search::Args),
     /// Zero-shot style transfer from one example clip; train the autoencoder, evaluate.
@@ -87,6 +89,7 @@ fn main() -> ExitCode {
         Command::Positions(args) => commands::positions::run(args, &options),
         Command::Fuse(args) => commands::fuse::run(args, &options),
         Command::Clean(args) => commands::clean::run(*args, &options),
+        Command::Feet(args) => commands::feet::run(args, &options),
         Command::Search(args) => commands::search::run(args, &options),
         Command::Style(args) => commands::style::run(args, &options),
         Command::View(args) => commands::view::view(args, &options),

@@ -156,3 +156,114 @@ pub fn end_site_positions(
     }
     out
 }
+
+/// Two-bone inverse kinematics: the world-space turns of the hip (about
+/// the hip) and of the knee (about the knee, applied before the hip's) that
+/// bring the ankle `a` of the chain hip `h` - knee `k` - ankle `a` as close
+/// to `target` as the bone lengths allow. The knee bends in the plane it
+/// already bends in. `None` for a straight or degenerate leg.
+///
+/// Applied to a leg: the hip's new global rotation is `turn_hip * R_hip`,
+/// the knee's `turn_hip * turn_knee * R_knee`; the bones keep their lengths.
+pub fn two_bone_ik(h: Vec3, k: Vec3, a: Vec3, target: Vec3) -> Option<(Quat, Quat)> {
+    let thigh = (k - h).length();
+    let shin = (a - k).length();
+    if thigh < 1e-6 || shin < 1e-6 {
+        return None;
+    }
+    let reach = (target - h)
+        .length()
+        .clamp((thigh - shin).abs() + 1e-4, thigh + shin - 1e-4);
+    let axis = (k - h).cross(a - k);
+    if axis.length() < 1e-6 * thigh * shin {
+        return None;
+    }
+    let axis = axis.normalize();
+    // Interior knee angle now and the one that gives the wanted reach.
+    let interior = (h - k)
+        .normalize()
+        .dot((a - k).normalize())
+        .clamp(-1.0, 1.0)
+        .acos();
+    let wanted = ((thigh * thigh + shin * shin - reach * reach) / (2.0 * thigh * shin))
+        .clamp(-1.0, 1.0)
+        .acos();
+    // Turning the shin about `axis` changes the interior angle by the turn
+    // in one direction: take the sign that reaches `reach`.
+    let delta = wanted - interior;
+    let candidates = [
+        Quat::from_axis_angle(axis, delta),
+        Quat::from_axis_angle(axis, -delta),
+    ];
+    let turn_knee = candidates
+        .into_iter()
+        .min_by(|p, q| {
+            let dp = ((k + *p * (a - k)) - h).length() - reach;
+            let dq = ((k + *q * (a - k)) - h).length() - reach;
+            dp.abs().total_cmp(&dq.abs())
+        })
+        .expect("two candidates");
+    let moved = k + turn_knee * (a - k);
+    let from = (moved - h).normalize();
+    let to = (target - h).normalize();
+    let turn_hip = Quat::from_rotation_arc(from, to);
+    Some((turn_hip, turn_knee))
+}
+
+/// The largest `s` in [0, 1] with `|ankle + s shift| <= reach`, for an
+/// ankle (relative to the hip) within `reach` (a leg reaches at most its
+/// length): the root of the quadratic `|ankle + s shift|^2 = reach^2` on
+/// the far side. How much of a wanted `shift` of the ankle a leg can follow.
+pub fn within_reach(ankle: Vec3, shift: Vec3, reach: f32) -> f32 {
+    let a = shift.dot(shift);
+    if a <= 0.0 {
+        return 0.0;
+    }
+    let b = 2.0 * ankle.dot(shift);
+    let c = ankle.dot(ankle) - reach * reach;
+    ((-b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a)).clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shift_is_shortened_to_the_reach_along_its_direction() {
+        let ankle = Vec3::new(10.0, -80.0, 0.0);
+        let shift = Vec3::new(60.0, 0.0, 5.0);
+        let s = within_reach(ankle, shift, 85.0);
+        assert!(s > 0.0 && s < 1.0, "{s}");
+        assert!(((ankle + shift * s).length() - 85.0).abs() < 1e-3);
+        // Already within reach: the whole shift.
+        assert_eq!(within_reach(ankle, shift * 0.01, 85.0), 1.0);
+        assert_eq!(within_reach(ankle, Vec3::ZERO, 85.0), 0.0);
+    }
+
+    #[test]
+    fn two_bone_reaches_a_reachable_target() {
+        let h = Vec3::new(0.0, 90.0, 0.0);
+        let k = Vec3::new(0.0, 48.0, 8.0);
+        let a = Vec3::new(0.0, 8.0, 0.0);
+        for target in [
+            Vec3::new(5.0, 8.0, 10.0),
+            Vec3::new(-6.0, 10.0, -12.0),
+            Vec3::new(0.0, 20.0, 3.0),
+        ] {
+            let (turn_hip, turn_knee) = two_bone_ik(h, k, a, target).expect("bent leg");
+            let new_knee = h + turn_hip * (k - h);
+            let new_ankle = new_knee + turn_hip * turn_knee * (a - k);
+            assert!(
+                (new_ankle - target).length() < 1e-2,
+                "{new_ankle:?} vs {target:?}"
+            );
+            // Bone lengths are kept.
+            assert!(((new_knee - h).length() - (k - h).length()).abs() < 1e-3);
+            assert!(((new_ankle - new_knee).length() - (a - k).length()).abs() < 1e-3);
+        }
+        // Out of reach: the leg stretches towards it.
+        let (turn_hip, turn_knee) = two_bone_ik(h, k, a, Vec3::new(0.0, -200.0, 0.0)).unwrap();
+        let new_ankle = h + turn_hip * (k - h) + turn_hip * turn_knee * (a - k);
+        assert!(new_ankle.y < a.y);
+    }
+}

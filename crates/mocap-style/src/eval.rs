@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use mocap_core::metrics::jitter;
+use mocap_core::metrics::{self, jitter};
 use mocap_core::rotation::Vec3;
 use mocap_core::{forward_kinematics, GlobalPoses, Motion};
 use mocap_nn::device::DeviceChoice;
@@ -42,7 +42,7 @@ use crate::apply::{
 };
 use crate::classify::{ClassifierConfig, ClipClassifier, Descriptor, Model, Windows};
 use crate::classify_net::NetConfig;
-use crate::contact::{flat_foot_steps, heights_above_ground, travelled};
+use crate::contact::travelled;
 use crate::convert::{ConvertOptions, Method};
 use crate::data::{held_out, labelled_paths, list_bvh, load_clips, Clip, ClipFilter, HeldOutTake};
 use crate::features::{gait_period, up_axis, RigLayout};
@@ -406,39 +406,16 @@ impl FootFrame {
         }
     }
 
-    /// Horizontal speed of `joint` from frame `f - 1` to `f`, units per second.
-    fn horizontal_speed(&self, f: usize, joint: usize) -> f32 {
-        let d = self.poses.position(f, joint) - self.poses.position(f - 1, joint);
-        d.reject_from_normalized(self.up).length() * self.fps
+    fn feet(rig: &RigLayout) -> [&[usize]; 2] {
+        [&rig.left_foot, &rig.right_foot]
     }
 
     fn foot_skating(&self, rig: &RigLayout) -> f64 {
-        let tolerance = 0.05 * self.leg;
-        let mut speeds = Vec::new();
-        for &j in rig.left_foot.iter().chain(&rig.right_foot) {
-            let h = heights_above_ground(&self.poses, j, self.up);
-            for f in 1..self.poses.frame_count {
-                if h[f] <= tolerance && h[f - 1] <= tolerance {
-                    speeds.push(self.horizontal_speed(f, j));
-                }
-            }
-        }
-        mean_or_zero(&speeds)
+        metrics::foot_skating(&self.poses, Self::feet(rig), self.up, self.leg, self.fps)
     }
 
     fn planted_foot_sliding(&self, rig: &RigLayout) -> f64 {
-        let flat = flat_foot_steps(&self.poses, rig, self.up, self.leg);
-        let mut speeds = Vec::new();
-        for (foot, steps) in [&rig.left_foot, &rig.right_foot].into_iter().zip(&flat) {
-            for f in (1..self.poses.frame_count).filter(|&f| steps[f - 1]) {
-                let slowest = foot
-                    .iter()
-                    .map(|&j| self.horizontal_speed(f, j))
-                    .fold(f32::INFINITY, f32::min);
-                speeds.push(slowest);
-            }
-        }
-        mean_or_zero(&speeds)
+        metrics::planted_foot_sliding(&self.poses, Self::feet(rig), self.up, self.leg, self.fps)
     }
 
     fn largest_foot_reach(&self, rig: &RigLayout) -> f64 {
@@ -454,15 +431,6 @@ impl FootFrame {
             }
         }
         (largest / self.leg.max(1e-6)) as f64
-    }
-}
-
-/// The mean of `speeds` in f64 (0 for none).
-fn mean_or_zero(speeds: &[f32]) -> f64 {
-    if speeds.is_empty() {
-        0.0
-    } else {
-        speeds.iter().map(|&v| v as f64).sum::<f64>() / speeds.len() as f64
     }
 }
 

@@ -31,11 +31,11 @@
 //! (`mocap_nn::kinematics`, shared with `mocap-clean`'s position loss).
 
 use burn::tensor::{Device, Tensor, TensorData};
+use mocap_core::metrics;
 use mocap_core::rotation::{Mat3, Quat};
 use mocap_core::{forward_kinematics, Motion, Skeleton};
 use mocap_nn::kinematics::{child_position, compose, Columns};
 
-use crate::contact;
 use crate::features::{up_axis, Normalization, RigLayout, SLOT_DIM};
 
 /// Forward kinematics of the feet, from standardised features.
@@ -206,7 +206,8 @@ fn exp_columns(v: &[Tensor<3>; 3]) -> Columns {
 pub fn flat_foot_steps(motion: &Motion, rig: &RigLayout) -> Vec<f32> {
     let poses = forward_kinematics(motion);
     let up = up_axis(&poses.positions, poses.joint_count, rig);
-    let flat = contact::flat_foot_steps(&poses, rig, up, rig.leg_length(motion.skeleton()));
+    let feet = [rig.left_foot.as_slice(), rig.right_foot.as_slice()];
+    let flat = metrics::flat_foot_steps(&poses, feet, up, rig.leg_length(motion.skeleton()));
     let mut out = Vec::new();
     for step in 0..poses.frame_count.saturating_sub(1) {
         for (steps, foot) in flat.iter().zip([&rig.left_foot, &rig.right_foot]) {

@@ -5,6 +5,7 @@ pub mod args;
 pub mod clean;
 pub mod convert;
 pub mod demo;
+pub mod feet;
 pub mod fuse;
 pub mod info;
 pub mod positions;
