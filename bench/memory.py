@@ -77,7 +77,7 @@ def run(command, limit_kb, limit_s, log):
     start = time.monotonic()
     with open(log, "wb") as out:
         p = subprocess.Popen(["/usr/bin/time", "-v", "-o", stats] + command,
-                             stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+                             stdout=out, stderr=subprocess.STDOUT, process_group=0)
     stopped, watched_peak = None, 0
     while p.poll() is None:
         rss = sum(rss_kb(c) for c in children(p.pid))
