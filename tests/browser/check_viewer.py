@@ -1,9 +1,9 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Browser test of the mocap viewer, in a real headless Chromium.
 
 Starts the viewer on a free loopback port with the given motion files,
-drives Chromium through chromedriver (the W3C WebDriver protocol, spoken
-with the standard library only), and checks what a person would:
+drives Chromium through chromedriver (W3C WebDriver, with selenium, Debian's
+python3-selenium), and checks what a person would:
 
 - the page loads and shows one skeleton per file, with the frame and joint
   counts written in the files (read here from the BVH text, independently of
@@ -31,68 +31,50 @@ import urllib.error
 import urllib.request
 import zlib
 
+from selenium import webdriver
+from selenium.webdriver.common.actions.action_builder import ActionBuilder
+from selenium.webdriver.common.by import By
+
 BACKGROUND = (0xF4, 0xF4, 0xF2)
 
 
-# ---------- a minimal WebDriver client ----------
+# ---------- the WebDriver client (selenium, on the chromedriver started here) ----------
 
 class WebDriver:
     def __init__(self, base):
         self.base = base
-        # The id the driver gives the browser it started (W3C WebDriver
-        # names its endpoints and this id after its own word for that).
-        self.browser_id = None
-
-    def call(self, method, path, body=None, timeout=60):
-        data = None if body is None else json.dumps(body).encode()
-        request = urllib.request.Request(
-            self.base + path, data=data, method=method,
-            headers={"Content-Type": "application/json"})
-        try:
-            with urllib.request.urlopen(request, timeout=timeout) as response:
-                return json.loads(response.read() or b"{}").get("value")
-        except urllib.error.HTTPError as e:
-            raise RuntimeError(f"WebDriver {method} {path}: {e.code} {e.read()[:500]!r}") from None
+        self.browser = None
 
     def start(self, chromium):
-        value = self.call("POST", "/session", {"capabilities": {"alwaysMatch": {
-            "browserName": "chrome",
-            "goog:chromeOptions": {
-                "binary": chromium,
-                "args": ["--headless=new", "--no-sandbox", "--disable-gpu",
-                         "--disable-dev-shm-usage", "--window-size=1200,800",
-                         "--force-device-scale-factor=1"],
-            },
-        }}})
-        self.browser_id = value["sessionId"]
-
-    def s(self, path):
-        return f"/session/{self.browser_id}{path}"
+        options = webdriver.ChromeOptions()
+        options.binary_location = chromium
+        for arg in ["--headless=new", "--no-sandbox", "--disable-gpu",
+                    "--disable-dev-shm-usage", "--window-size=1200,800",
+                    "--force-device-scale-factor=1"]:
+            options.add_argument(arg)
+        self.browser = webdriver.Remote(command_executor=self.base, options=options)
 
     def get(self, url):
-        self.call("POST", self.s("/url"), {"url": url})
+        self.browser.get(url)
 
     def js(self, script, *args):
-        return self.call("POST", self.s("/execute/sync"), {"script": script, "args": list(args)})
+        return self.browser.execute_script(script, *args)
 
     def click(self, css):
-        element = self.call("POST", self.s("/element"), {"using": "css selector", "value": css})
-        element_id = next(iter(element.values()))
-        self.call("POST", self.s(f"/element/{element_id}/click"), {})
+        self.browser.find_element(By.CSS_SELECTOR, css).click()
 
     def move_pointer(self, x, y):
-        self.call("POST", self.s("/actions"), {"actions": [{
-            "type": "pointer", "id": "mouse", "parameters": {"pointerType": "mouse"},
-            "actions": [{"type": "pointerMove", "duration": 0, "origin": "viewport",
-                         "x": int(x), "y": int(y)}]}]})
+        actions = ActionBuilder(self.browser)
+        actions.pointer_action.move_to_location(int(x), int(y))
+        actions.perform()
 
     def screenshot(self):
-        return base64.b64decode(self.call("GET", self.s("/screenshot")))
+        return self.browser.get_screenshot_as_png()
 
     def quit(self):
-        if self.browser_id:
+        if self.browser:
             try:
-                self.call("DELETE", self.s(""), timeout=20)
+                self.browser.quit()
             except Exception:
                 pass
 
@@ -387,7 +369,8 @@ def main():
 
 def _status_ok(driver):
     try:
-        return driver.call("GET", "/status", timeout=2).get("ready")
+        with urllib.request.urlopen(driver.base + "/status", timeout=2) as response:
+            return json.loads(response.read()).get("value", {}).get("ready")
     except Exception:
         return False
 

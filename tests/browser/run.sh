@@ -11,13 +11,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
+# Debian's Python, which has Debian's selenium (not a pyenv or venv python3).
+PYTHON=/usr/bin/python3
 if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null 2>&1 \
-    || ! command -v python3 >/dev/null 2>&1; then
-    echo "== installing chromium, chromium-driver and python3 (Debian packages)"
+    || ! "$PYTHON" -c "import selenium" >/dev/null 2>&1; then
+    echo "== installing chromium, chromium-driver and python3-selenium (Debian packages)"
     SUDO=""
     if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
     $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver python3 >/dev/null
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver python3 python3-selenium >/dev/null
 fi
 
 echo "== building mocap"
@@ -36,5 +38,5 @@ fi
 
 OUT_DIR="${OUT:-$TARGET_DIR/browser-test}"
 echo "== headless Chromium"
-python3 tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" --with-fused \
+"$PYTHON" tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" --with-fused \
     --chromium "$(command -v chromium)" --chromedriver "$(command -v chromedriver)" "${FILES[@]}"
