@@ -18,7 +18,6 @@ Prints one line per check and "N passed, N failed"; exits 1 on a failure.
 """
 
 import argparse
-import base64
 import json
 import os
 import re
@@ -27,7 +26,6 @@ import struct
 import subprocess
 import sys
 import time
-import urllib.error
 import urllib.request
 import zlib
 
