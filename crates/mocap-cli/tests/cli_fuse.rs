@@ -216,12 +216,20 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
     assert_eq!(again["fused_frames"], report["fused_frames"]);
 }
 
-#[test]
-fn serve_and_send_over_loopback() {
-    let (dir, sim) = simulated(&[]);
-    let d = dir.path();
-    let live = d.join("live.jsonl");
-    let live_bvh = d.join("live.bvh");
+/// Starts `mocap fuse serve` on 127.0.0.1 (a free port) with the simulated
+/// take's calibration and body, writing `live` and `live_bvh`, stopping
+/// after 1 s without datagrams or after `duration` seconds; returns the
+/// process, the address it listens on and the rest of its standard error.
+fn start_server(
+    sim: &Path,
+    live: &Path,
+    live_bvh: &Path,
+    duration: &str,
+) -> (
+    std::process::Child,
+    String,
+    std::io::Lines<BufReader<std::process::ChildStderr>>,
+) {
     let mut server = Command::new(env!("CARGO_BIN_EXE_mocap"))
         .args([
             "fuse",
@@ -233,13 +241,13 @@ fn serve_and_send_over_loopback() {
             "--listen",
             "127.0.0.1:0",
             "-o",
-            &s(&live),
+            &s(live),
             "-o",
-            &s(&live_bvh),
+            &s(live_bvh),
             "--idle-exit",
             "1",
             "--duration",
-            "30",
+            duration,
             "--json",
         ])
         .stdout(Stdio::piped())
@@ -257,6 +265,16 @@ fn serve_and_send_over_loopback() {
             break rest.split_whitespace().next().unwrap().to_string();
         }
     };
+    (server, addr, lines)
+}
+
+#[test]
+fn serve_and_send_over_loopback() {
+    let (dir, sim) = simulated(&[]);
+    let d = dir.path();
+    let live = d.join("live.jsonl");
+    let live_bvh = d.join("live.bvh");
+    let (server, addr, _lines) = start_server(&sim, &live, &live_bvh, "30");
     let started = Instant::now();
     let mut args = vec!["fuse".to_string(), "send".into()];
     args.extend(recordings(&sim));
@@ -328,40 +346,7 @@ fn serve_a_take_with(hostile: impl FnOnce(&Path) -> Vec<Hostile>) -> Served {
     let d = dir.path();
     let live = d.join("live.jsonl");
     let live_bvh = d.join("live.bvh");
-    let mut server = Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args([
-            "fuse",
-            "serve",
-            "--calib",
-            &s(&sim.join("truth.calib.toml")),
-            "--body",
-            &s(&sim.join("body.json")),
-            "--listen",
-            "127.0.0.1:0",
-            "-o",
-            &s(&live),
-            "-o",
-            &s(&live_bvh),
-            "--idle-exit",
-            "1",
-            "--duration",
-            "60",
-            "--json",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut lines = BufReader::new(server.stderr.take().unwrap()).lines();
-    let addr = loop {
-        let line = lines
-            .next()
-            .expect("the server prints its address")
-            .unwrap();
-        if let Some(rest) = line.split("listening on ").nth(1) {
-            break rest.split_whitespace().next().unwrap().to_string();
-        }
-    };
+    let (mut server, addr, lines) = start_server(&sim, &live, &live_bvh, "60");
     // The rest of standard error, read as it comes so that the server
     // never blocks on a full pipe.
     let log = std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>());
