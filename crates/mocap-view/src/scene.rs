@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 
 use mocap_core::io::read_motions;
-use mocap_core::kinematics::{end_site_positions, forward_kinematics};
+use mocap_core::kinematics::{end_site_positions, forward_kinematics_range, frame_pieces};
 use mocap_core::rotation::Vec3;
 use mocap_core::{Error, Motion, Result};
 use serde::Serialize;
@@ -90,16 +90,20 @@ impl ViewMotion {
                 parents.push(Some(j));
             }
         }
-        let poses = forward_kinematics(motion);
         let point_count = names.len();
         let mut positions = Vec::with_capacity(point_count * motion.frame_count());
-        for f in 0..motion.frame_count() {
-            positions.extend_from_slice(poses.frame_positions(f));
-            positions.extend(
-                end_site_positions(motion, &poses, f)
-                    .into_iter()
-                    .map(|(_, p)| p),
-            );
+        // A piece of the take at a time: the full global poses (rotations
+        // too) of a long take would take more memory than its positions.
+        for piece in frame_pieces(motion.frame_count()) {
+            let poses = forward_kinematics_range(motion, piece);
+            for f in 0..poses.frame_count {
+                positions.extend_from_slice(poses.frame_positions(f));
+                positions.extend(
+                    end_site_positions(motion, &poses, f)
+                        .into_iter()
+                        .map(|(_, p)| p),
+                );
+            }
         }
         let bones: Vec<bool> = (0..point_count)
             .map(|p| p >= joint_count || (parents[p].is_some() && !translates(motion, p)))
