@@ -53,8 +53,9 @@
 //! the spread between seeds, so they are not included.
 
 use mocap_core::bodymap::{BodyMap, BodyPart};
+use mocap_core::kinematics::{forward_kinematics_range, frame_pieces};
 use mocap_core::rotation::Vec3;
-use mocap_core::{forward_kinematics, GlobalPoses, Motion};
+use mocap_core::Motion;
 
 use crate::error::{Result, SearchError};
 use crate::intervals::FeatureSequence;
@@ -197,16 +198,41 @@ impl KeyJoints {
 /// The per-frame features of a motion, at its own frame rate.
 pub fn motion_features(motion: &Motion) -> Result<FeatureSequence> {
     let joints = KeyJoints::detect(motion.skeleton())?;
-    let poses = forward_kinematics(motion);
+    // Positions only, a piece of the take at a time: the full global poses
+    // (rotations too) of a long take would take twice the memory.
+    let joint_count = motion.skeleton().joint_count();
+    let mut positions = Vec::with_capacity(joint_count * motion.frame_count());
+    for piece in frame_pieces(motion.frame_count()) {
+        positions.extend(forward_kinematics_range(motion, piece).positions);
+    }
+    let poses = Positions::new(&positions, joint_count);
     pose_features(&poses, &joints, &motion.skeleton().parents(), motion.fps())
 }
 
+/// The global joint positions of every frame of a take (what the features
+/// are made of), `joint_count` to a frame.
+pub(crate) struct Positions<'a> {
+    joint_count: usize,
+    frame_count: usize,
+    positions: &'a [Vec3],
+}
+
+impl<'a> Positions<'a> {
+    pub(crate) fn new(positions: &'a [Vec3], joint_count: usize) -> Positions<'a> {
+        Positions {
+            joint_count,
+            frame_count: positions.len() / joint_count.max(1),
+            positions,
+        }
+    }
+
+    fn position(&self, frame: usize, joint: usize) -> Vec3 {
+        self.positions[frame * self.joint_count + joint]
+    }
+}
+
 /// Body height `h` (see the module docs) from the first frame.
-pub(crate) fn body_height(
-    poses: &GlobalPoses,
-    joints: &KeyJoints,
-    parents: &[Option<usize>],
-) -> f32 {
+pub(crate) fn body_height(poses: &Positions, joints: &KeyJoints, parents: &[Option<usize>]) -> f32 {
     // Length of the bone chain from `from` up to its ancestor `to`.
     let chain = |from: usize, to: usize| -> f32 {
         let mut length = 0.0;
@@ -235,7 +261,7 @@ fn angle(a: Vec3, b: Vec3) -> f32 {
 /// The unit lateral (left) axis of every frame's body-centred frame. Where
 /// hips and shoulders give no horizontal direction (lying down), the
 /// previous frame's axis is kept.
-fn lateral_axes(poses: &GlobalPoses, j: &KeyJoints) -> Vec<Vec3> {
+fn lateral_axes(poses: &Positions, j: &KeyJoints) -> Vec<Vec3> {
     let mut axes = Vec::with_capacity(poses.frame_count);
     let mut last = Vec3::X;
     for f in 0..poses.frame_count {
@@ -279,7 +305,7 @@ fn second_difference_frames(f: usize, frames: usize) -> Option<(usize, usize, us
 /// `parents` gives each joint's parent (for the body height) and `fps`
 /// turns frame differences into velocities per second.
 pub(crate) fn pose_features(
-    poses: &GlobalPoses,
+    poses: &Positions,
     j: &KeyJoints,
     parents: &[Option<usize>],
     fps: f64,
@@ -427,7 +453,13 @@ mod tests {
         let joints = KeyJoints::detect(motion.skeleton()).unwrap();
         let parents = motion.skeleton().parents();
         let poses = forward_kinematics(&motion);
-        let base = pose_features(&poses, &joints, &parents, motion.fps()).unwrap();
+        let base = pose_features(
+            &Positions::new(&poses.positions, poses.joint_count),
+            &joints,
+            &parents,
+            motion.fps(),
+        )
+        .unwrap();
         assert_eq!(base.dim, VALUE_COUNT);
         assert_eq!(base.frame_count(), motion.frame_count());
         let moved = transform(
@@ -436,7 +468,13 @@ mod tests {
             Vec3::new(300.0, 0.0, -120.0),
             0.62,
         );
-        let other = pose_features(&moved, &joints, &parents, motion.fps()).unwrap();
+        let other = pose_features(
+            &Positions::new(&moved.positions, moved.joint_count),
+            &joints,
+            &parents,
+            motion.fps(),
+        )
+        .unwrap();
         // Relative to the value's size where it exceeds 1: the wrist
         // accelerations (values 74-75) are second differences of positions
         // times fps², so they carry the positions' f32 rounding times 900.
