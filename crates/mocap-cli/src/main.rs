@@ -51,7 +51,7 @@ enum Command {
     View(commands::view::ViewArgs),
     /// Draw motions as a filmstrip PNG or an animated GIF.
     Render(commands::view::RenderArgs),
-    /// Run the whole pipeline (fuse, clean, search, restyle) on bundled data and write an HTML report.
+    /// Run the whole pipeline (fuse, clean, feet, search, restyle) on bundled data and write an HTML report.
     Demo(commands::demo::Args),
 }
 

@@ -96,6 +96,21 @@ fn demo_writes_a_report_with_honest_statuses() {
     let message = clean["message"].as_str().unwrap();
     assert!(message.contains("no-such-model.safetensors"), "{message}");
     assert!(html.contains("no-such-model.safetensors"));
+    // The chain goes on without it, with the fused take.
+    let feet = stage(&report, "feet");
+    assert_eq!(feet["status"], "ran", "{feet}");
+    let input = feet["facts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f[0] == "input")
+        .expect("the feet stage names its input");
+    assert!(
+        input[1]
+            .as_str()
+            .is_some_and(|p| p.ends_with("fused-on-sample-rig.bvh")),
+        "{feet}"
+    );
 
     // Fusion needs no model: it runs, on every frame of the take, and the
     // fused joints are closer to the truth than a Kinect's error scale
@@ -139,8 +154,21 @@ fn demo_writes_a_report_with_honest_statuses() {
     }
 }
 
+fn fact<'a>(stage: &'a Value, name: &str) -> &'a str {
+    stage["facts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f[0] == name)
+        .unwrap_or_else(|| panic!("stage {} has no fact {name}", stage["name"]))[1]
+        .as_str()
+        .unwrap()
+}
+
+/// The demo runs one chain: fused take -> cleaned -> feet planted ->
+/// searched and restyled, each stage reading what the one before wrote.
 #[test]
-fn demo_cleans_the_noisy_sample_with_the_shipped_model() {
+fn demo_runs_the_fused_take_through_the_whole_chain() {
     if !workspace()
         .join("models/clean-default.safetensors")
         .is_file()
@@ -150,15 +178,43 @@ fn demo_cleans_the_noisy_sample_with_the_shipped_model() {
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");
-    let report = demo(&out, &["--no-pictures", "--sensors", "1"]);
+    let report = demo(&out, &["--no-pictures"]);
+    for s in report["stages"].as_array().unwrap() {
+        check_consistent(&out, s);
+    }
+    let fuse = stage(&report, "fuse");
+    assert_eq!(fuse["status"], "ran", "{fuse}");
+    // The fused take on the sample's rig is within centimetres of the sample.
+    let on_rig = number(fuse, "on_rig_position_error_mm");
+    assert!(on_rig > 0.0 && on_rig < 200.0, "{on_rig} mm");
+
     let clean = stage(&report, "clean");
     assert_eq!(clean["status"], "ran", "{clean}");
-    check_consistent(&out, clean);
-    let before = number(clean, "rotation_error_noisy_deg");
-    let after = number(clean, "rotation_error_cleaned_deg");
-    assert!(before > 0.0, "the noise changed nothing");
+    assert!(fact(clean, "input").ends_with("fused-on-sample-rig.bvh"));
+    // The clean stage starts from the fuse stage's take: its "fused" error
+    // is the one the fuse stage measured.
+    assert!((number(clean, "position_error_fused_mm") - on_rig).abs() < 1e-6);
+    assert!(number(clean, "jitter_fused") > 0.0);
+
+    let feet = stage(&report, "feet");
+    assert_eq!(feet["status"], "ran", "{feet}");
+    assert!(fact(feet, "input").ends_with("cleaned.bvh"));
+    assert!(number(feet, "contacts") > 0.0, "{feet}");
+    let (before, after) = (
+        number(feet, "sliding_before_cm_s"),
+        number(feet, "sliding_after_cm_s"),
+    );
     assert!(
         after < before,
-        "the denoiser did not reduce the rotation error: {before} -> {after} degrees"
+        "feet did not slide less: {before} -> {after} cm/s"
     );
+
+    let search = stage(&report, "search");
+    if search["status"] == "ran" {
+        assert!(fact(search, "query").ends_with("planted.bvh"), "{search}");
+    }
+    let style = stage(&report, "style");
+    if style["status"] == "ran" {
+        assert!(fact(style, "source").ends_with("planted.bvh"), "{style}");
+    }
 }

@@ -19,16 +19,21 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use anyhow::{anyhow, Context};
+use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
-use mocap_core::rotation::Vec3;
+use mocap_core::retarget::Retargeting;
+use mocap_core::rotation::{Quat, Vec3};
+use mocap_core::Motion;
 use mocap_fuse::{
-    fit_error, fused_to_motion, poses_to_motion, regular_poses, simulate_capture, views_at,
-    BvhOptions, FusedFrame, FusionOptions, MemorySink, SendOptions, SendReport, SensorFrame,
-    SensorStreams, ServeOptions, ServeReport, SimulatedCapture, SimulationOptions, JOINT_COUNT,
+    fit_error, fused_to_motion, poses_to_motion, regular_poses, simulate_capture,
+    truth_from_motion, views_at, BvhOptions, FusedFrame, FusionOptions, GroundTruth, MemorySink,
+    SendOptions, SendReport, SensorFrame, SensorStreams, ServeOptions, ServeReport,
+    SimulatedCapture, SimulationOptions, JOINT_COUNT,
 };
 use mocap_view::{plot_lines, render_files, LinePlot, RenderOptions, Series};
 
-use crate::{viewer_command, StageContext, StageReport, StageResult};
+use crate::chain::{errors_against_truth, ChainTake};
+use crate::{units_per_metre, viewer_command, StageContext, StageReport, StageResult};
 
 /// Mean distance (metres) between two poses over the 25 joints.
 fn pose_error(a: &[Vec3; JOINT_COUNT], b: &[Vec3; JOINT_COUNT]) -> f64 {
@@ -86,6 +91,63 @@ fn stream_over_udp(
         .map_err(|_| anyhow!("the fusion server thread panicked"))?;
     let (report, fused) = served.context("fusion server")?;
     Ok((report, fused, sent?))
+}
+
+/// The file the chain goes on with.
+const ON_RIG_FILE: &str = "fused-on-sample-rig.bvh";
+
+/// `fused` (on the skeleton fitted to the Kinect joints, in the simulator's
+/// world) on the sample's rig and in the sample's world: retargeted by the
+/// two rigs' rest poses, then with the shift `center_truth` gave the truth
+/// (centring, and the treadmill that keeps a long walk in the sensors'
+/// view) added back to the root, so that planted feet stand still again.
+/// The fused frame `i` is the sample's instant `first_time + i / fps`.
+fn on_sample_rig(
+    fused: &Motion,
+    sample: &Motion,
+    centred: &GroundTruth,
+    first_time: f64,
+) -> anyhow::Result<Motion> {
+    let retargeting = Retargeting::detect(fused.skeleton(), sample.skeleton())
+        .context("cannot relate the fused skeleton to the sample's rig")?;
+    let mut out = retargeting.apply(fused)?;
+    let raw = truth_from_motion(sample, None)?;
+    let units = units_per_metre(sample);
+    // The joint that carries the walk, as the retargeting moved it: the
+    // pelvis where it has position channels (Bandai's rig keeps its root
+    // still at the floor and moves the hips), else the root (joint 0, the
+    // first of a hierarchy). Both have no rotated parent in these rigs, so
+    // the world shift is added as it is.
+    let skeleton = out.skeleton();
+    let moved = BodyMap::detect(skeleton)?
+        .joint(BodyPart::Pelvis)
+        .filter(|&j| skeleton.joint(j).has_position_channels())
+        .unwrap_or(0);
+    if !skeleton.joint(moved).has_position_channels() {
+        return Err(anyhow!(
+            "the sample's root joint has no position channels: it cannot carry the walk"
+        ));
+    }
+    let above: Vec<usize> =
+        std::iter::successors(skeleton.joint(moved).parent, |&p| skeleton.joint(p).parent)
+            .collect();
+    if raw.frames.len() != centred.frames.len() || raw.frames.is_empty() {
+        return Err(anyhow!("the ground truth does not match the sample"));
+    }
+    for f in 0..out.frame_count() {
+        let t = first_time + f as f64 * out.frame_time();
+        let k = ((t * raw.fps).round().max(0.0) as usize).min(raw.frames.len() - 1);
+        // Every joint was shifted alike: the first tells the shift.
+        let shift = (raw.frames[k][0] - centred.frames[k][0]) * units;
+        // Into the axes of the moved joint's parent.
+        let turn = above
+            .iter()
+            .rev()
+            .fold(Quat::IDENTITY, |q, &p| q * out.local_rotation(f, p));
+        let translation = out.local_translation(f, moved);
+        out.set_local_translation(f, moved, translation + turn.inverse() * shift);
+    }
+    Ok(out)
 }
 
 pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResult {
@@ -195,6 +257,23 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     );
     report.viewer_command = Some(viewer_command(&[&truth_path, &fused_path]));
 
+    // The chain goes on with the fused take on the sample's rig, in the
+    // sample's world (see `chain`).
+    let first_time = fused[0].time;
+    let on_rig = on_sample_rig(&fused_motion, &motion, truth, first_time)?;
+    let on_rig_path = context.path("fuse", ON_RIG_FILE)?;
+    write_bvh(&on_rig_path, &on_rig)?;
+    report.output(
+        StageContext::relative("fuse", ON_RIG_FILE),
+        "fused.bvh retargeted onto the sample's rig and taken off the simulator's treadmill: what the next stages get",
+    );
+    let on_rig_errors = errors_against_truth(&on_rig, &motion, first_time)?;
+    context.pass_on(ChainTake {
+        path: on_rig_path,
+        stage: "fuse",
+        first_time,
+    });
+
     report.number(
         "sensors",
         "simulated Kinect v2 sensors",
@@ -255,6 +334,30 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
         "fused.bvh's forward kinematics vs the fused joints (fixed bone lengths)",
         fit.mean_mm,
         "mm",
+    );
+    report.number(
+        "on_rig_position_error_mm",
+        "fused take on the sample's rig vs the sample, mean per-joint position error (all joints of the rig)",
+        on_rig_errors.position_mm,
+        "mm",
+    );
+    report.number(
+        "on_rig_rotation_error_deg",
+        "fused take on the sample's rig vs the sample, mean angle of the local joint rotations",
+        on_rig_errors.rotation_deg,
+        "deg",
+    );
+    report.number(
+        "on_rig_jitter",
+        "fused take on the sample's rig, mean jerk of its joints (mm/frame³)",
+        on_rig_errors.jitter,
+        "mm/frame³",
+    );
+    report.number(
+        "sample_jitter",
+        "the sample's own mean jerk over the same frames (mm/frame³)",
+        on_rig_errors.truth_jitter,
+        "mm/frame³",
     );
     report.fact(
         "fusion",

@@ -3,19 +3,22 @@
 //! `mocap demo`: the whole pipeline on data bundled with the project, in one
 //! command, with an HTML report of what each stage did.
 //!
+//! One take goes through the whole chain ([`chain`]), and each stage reports
+//! its error against the ground truth, the sample itself:
+//!
 //! 1. **fuse** ([`fuse`]): the bundled Bandai Namco walk is watched by
 //!    simulated Kinect v2 sensors (mocap-fuse `sim`); their frames are sent
 //!    over UDP on loopback, faster than real time, to the fusion server
 //!    (mocap-fuse `net`) running in a thread; the fused joints are compared
-//!    with the ground truth and written as a BVH on a fitted skeleton;
-//! 2. **clean** ([`clean`]): the shipped denoiser is trained on the Bandai
-//!    rig, not on the fused skeleton, so the honest test is on the sample
-//!    itself: the synthetic markerless noise of mocap-clean's `noise` module
-//!    is added to the take, the model cleans it, and rotation and position
-//!    errors against the take are reported before and after;
-//! 3. **search** ([`search`]): a small library index (Bandai dataset-2,
+//!    with the ground truth, written as a BVH on a fitted skeleton, and
+//!    retargeted onto the sample's rig for the next stages;
+//! 2. **clean** ([`clean`]): the shipped denoiser cleans that fused take,
+//!    with a classical filter (cross-validated Butterworth) beside it;
+//! 3. **feet** ([`feet`]): planted feet held still and above the floor
+//!    (mocap-feet);
+//! 4. **search** ([`search`]): a small library index (Bandai dataset-2,
 //!    content labels, `models/search-*.idx`) says what the actor is doing;
-//! 4. **style** ([`style`]): the take is restyled with a bundled style clip
+//! 5. **style** ([`style`]): the take is restyled with a bundled style clip
 //!    and the shipped style model (mocap-style `apply`).
 //!
 //! Each stage runs on its own: a failure, a missing model file or a stage
@@ -23,16 +26,20 @@
 //! the other stages still run. Every output file is written atomically.
 //! [`report`] writes `index.html` and `report.json` in the output folder.
 
+mod chain;
 pub mod clean;
+pub mod feet;
 pub mod fuse;
 pub mod report;
 pub mod search;
 pub mod style;
 
+use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use chain::ChainTake;
 use mocap_core::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -133,10 +140,8 @@ pub struct DemoOptions {
     pub search_index: PathBuf,
     /// Simulated sensors.
     pub sensors: usize,
-    /// Seed of the simulation and of the noise: same seed, same numbers.
+    /// Seed of the simulation: same seed, same numbers.
     pub seed: u64,
-    /// Standard deviation (degrees) of the per-joint noise of the clean stage.
-    pub noise_sigma_deg: f32,
     /// Playback speed of the UDP replay relative to real time.
     pub send_speed: f64,
     /// Draw filmstrips and plots.
@@ -154,7 +159,6 @@ impl Default for DemoOptions {
             search_index: bundled("models/search-bandai-content.idx"),
             sensors: 3,
             seed: 1,
-            noise_sigma_deg: 5.0,
             send_speed: 10.0,
             pictures: true,
         }
@@ -426,17 +430,23 @@ pub fn run_demo(options: &DemoOptions) -> Result<DemoReport> {
 pub fn run_demo_with(options: &DemoOptions, progress: &mut dyn FnMut(&str)) -> Result<DemoReport> {
     let started = Instant::now();
     std::fs::create_dir_all(&options.out).map_err(|e| Error::io(&options.out, e))?;
-    let context = StageContext { options };
+    let context = StageContext {
+        options,
+        take: RefCell::new(None),
+    };
     let stages = vec![
         run_stage("fuse", "Fuse: simulated sensors over UDP", progress, |r| {
             fuse::run(&context, r)
         }),
         run_stage(
             "clean",
-            "Clean: markerless noise removed by the denoiser",
+            "Clean: the fused take denoised by the shipped model",
             progress,
             |r| clean::run(&context, r),
         ),
+        run_stage("feet", "Feet: planted feet held still", progress, |r| {
+            feet::run(&context, r)
+        }),
         run_stage(
             "search",
             "Search: what is the actor doing?",
@@ -463,9 +473,25 @@ pub fn run_demo_with(options: &DemoOptions, progress: &mut dyn FnMut(&str)) -> R
 /// What every stage sees.
 pub struct StageContext<'a> {
     pub options: &'a DemoOptions,
+    /// The latest take of the chain (see [`chain`]).
+    take: RefCell<Option<ChainTake>>,
 }
 
 impl StageContext<'_> {
+    /// The latest take of the chain, or why there is none.
+    pub(crate) fn take(&self) -> std::result::Result<ChainTake, StageStop> {
+        self.take.borrow().clone().ok_or_else(|| {
+            StageStop::NotAvailable(
+                "no take to work on: the fuse stage, which starts the chain, did not run".into(),
+            )
+        })
+    }
+
+    /// Makes `take` the one the next stages work on.
+    pub(crate) fn pass_on(&self, take: ChainTake) {
+        *self.take.borrow_mut() = Some(take);
+    }
+
     /// A path in the report folder (`stage/file`), its folder created.
     pub(crate) fn path(&self, stage: &str, file: &str) -> std::io::Result<PathBuf> {
         let dir = self.options.out.join(stage);

@@ -1,4 +1,4 @@
-//! Stage 3: what is the actor doing? The sample is classified and the most
+//! Stage 4: what is the actor doing? The chain's take is classified and the most
 //! similar clips of a small bundled library are listed.
 //!
 //! The library index (`models/search-bandai-content.idx`) was built with
@@ -17,10 +17,12 @@ const TOP: usize = 5;
 pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResult {
     let options = context.options;
     require_file(&options.search_index, "the search library index")?;
+    let take = context.take()?;
     let index = Index::load(&options.search_index)?;
-    let answer = index.query_file(&options.sample, TOP, Ranking::Histogram)?;
-    let name = options
-        .sample
+    let answer = index.query_file(&take.path, TOP, Ranking::Histogram)?;
+    report.fact("query", take.path.display().to_string());
+    let name = take
+        .path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
@@ -67,7 +69,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     report.fact("labels", index.label_rule.clone());
     report.fact("index", options.search_index.display().to_string());
     report.note(
-        "The sample's name says `walk`; the library is Bandai dataset-2 (another dataset-1 take would be in neither), so a `walk` prediction is a real test on an unseen clip, not a lookup.",
+        "The query is the chain's take (fused, cleaned, feet planted) of the sample, whose name says `walk`; the library is Bandai dataset-2, not dataset-1, so a `walk` prediction is a real test on an unseen clip, not a lookup.",
     );
     if options.pictures {
         let path = context.path("search", "class_probabilities.png")?;
@@ -89,7 +91,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
         plot_bars(&path, &plot)?;
         report.picture(
             StageContext::relative("search", "class_probabilities.png"),
-            "class probabilities of the sample",
+            "class probabilities of the chain's take",
         );
     }
     Ok(())

@@ -1,4 +1,4 @@
-//! Stage 4: the sample restyled with a bundled style clip (mocap-style
+//! Stage 5: the chain's take restyled with a bundled style clip (mocap-style
 //! `apply`, elastic patches, the shipped style model).
 
 use mocap_core::io::bvh::read_bvh;
@@ -16,21 +16,19 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
             options.style_clip.display()
         )));
     }
+    let take = context.take()?;
     let out = context.path("style", "restyled.bvh")?;
-    let mut apply_options = ApplyOptions::new(&options.sample, &options.style_clip, &out);
+    let mut apply_options = ApplyOptions::new(&take.path, &options.style_clip, &out);
     apply_options.model = Some(options.style_model.clone());
     let applied = apply(&apply_options)?;
     // Read back what was written: the file is the result.
     let restyled = read_bvh(&out)?;
     report.output(
         StageContext::relative("style", "restyled.bvh"),
-        "the sample in the style of the style clip",
+        "the chain's take in the style of the style clip",
     );
-    report.viewer_command = Some(viewer_command(&[
-        &options.sample,
-        &options.style_clip,
-        &out,
-    ]));
+    report.viewer_command = Some(viewer_command(&[&take.path, &options.style_clip, &out]));
+    report.fact("source", take.path.display().to_string());
     report.fact("style clip", options.style_clip.display().to_string());
     report.fact("model", applied.model.clone());
     report.number(
@@ -66,11 +64,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     if options.pictures {
         let strip = context.path("style", "source_style_output.png")?;
         render_files(
-            &[
-                options.sample.clone(),
-                options.style_clip.clone(),
-                out.clone(),
-            ],
+            &[take.path.clone(), options.style_clip.clone(), out.clone()],
             &strip,
             &RenderOptions {
                 layout: Layout::SideBySide,

@@ -34,7 +34,7 @@ pub struct Args {
     /// Simulated sensors.
     #[arg(long, default_value_t = 3)]
     sensors: usize,
-    /// Seed of the simulation and the noise.
+    /// Seed of the simulated capture.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Skip filmstrips and plots.
