@@ -26,6 +26,7 @@ use std::time::Instant;
 use burn::tensor::{Tensor, TensorData};
 use mocap_core::io::bvh::write_bvh;
 use mocap_core::Motion;
+use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -288,6 +289,9 @@ pub struct CleanOptions {
     /// ([`crate::remove_spikes`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
+    /// Then hold planted feet still and above the floor (mocap-feet).
+    #[serde(default)]
+    pub feet: Option<FeetOptions>,
 }
 
 /// What `mocap clean apply IN -o OUT` reports.
@@ -305,6 +309,9 @@ pub struct CleanReport {
     /// The spikes found and bridged (with `despike`).
     #[serde(default)]
     pub spikes: Vec<BridgedSpike>,
+    /// What the feet stage did (with `feet`).
+    #[serde(default)]
+    pub feet: Option<FeetReport>,
 }
 
 /// A spike that was bridged, as reported: its joint by name (the joints
@@ -387,6 +394,20 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             )
         }
     };
+    let (cleaned, feet) = match &options.feet {
+        Some(feet) => {
+            let (planted, _, report) =
+                plant_feet_detected(&cleaned, feet).map_err(|e| match e {
+                    mocap_core::Error::Invalid(m) => CleanError::Invalid(format!(
+                        "{}: the feet stage (--feet): {m}",
+                        options.input.display()
+                    )),
+                    other => other.into(),
+                })?;
+            (planted, Some(report))
+        }
+        None => (cleaned, None),
+    };
     write_bvh(&options.output, &cleaned)?;
     let frames = motion.frame_count();
     let seconds = seconds + detect_seconds;
@@ -402,6 +423,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             .iter()
             .map(|s| BridgedSpike::new(&original, s))
             .collect(),
+        feet,
     })
 }
 
@@ -727,6 +749,7 @@ mod tests {
             device: DeviceChoice::Cpu,
             hop: None,
             despike: Some(despike),
+            feet: None,
         })
         .unwrap();
         assert_eq!(report.spikes.len(), 1, "{:?}", report.spikes);

@@ -40,6 +40,7 @@
 //!     device: Default::default(),
 //!     hop: None,
 //!     despike: None,
+//!     feet: None,
 //! })?;
 //! println!("{} frames, {:.2} degrees changed", report.frames, report.mean_change_deg);
 //!

@@ -117,3 +117,95 @@ fn feet_takes_a_studio_rig_described_with_rig() {
     assert_eq!(report["rig"], "Studio (German names)");
     assert!(output.exists());
 }
+
+/// Runs mocap and fails with its standard error if it did not succeed.
+fn mocap_ok(args: &[&str]) -> Output {
+    let out = mocap(args);
+    assert!(
+        out.status.success(),
+        "mocap {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// `--feet` on clean, style and fuse is the feet stage on their output:
+/// the file is the one `mocap feet` writes from the output without it.
+#[test]
+fn the_feet_option_writes_what_the_feet_command_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = |name: &str| dir.path().join(name);
+    let walk = mocap_testdata::sample_walk();
+    let style = mocap_testdata::repo_root().join("samples/dataset-1_walk_proud_001.bvh");
+    let same_as_feet_command = |with: &Path, without: &Path, name: &str| {
+        let planted = file(&format!("{name}-planted.bvh"));
+        mocap_ok(&["feet", path(without), "-o", path(&planted)]);
+        assert!(
+            std::fs::read(with).unwrap() == std::fs::read(&planted).unwrap(),
+            "{name} --feet differs from mocap feet on its output"
+        );
+    };
+
+    // clean, with the report of the feet stage in its JSON.
+    let filter = ["--filter", "butterworth-gcv:2"];
+    let (with, without) = (file("clean-feet.bvh"), file("clean.bvh"));
+    let out = mocap_ok(
+        &[
+            &["clean", "apply", path(&walk), "-o", path(&with)][..],
+            &filter,
+            &["--feet", "--json"],
+        ]
+        .concat(),
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        report["feet"]["after"]["sliding"].as_f64().is_some(),
+        "{report}"
+    );
+    mocap_ok(
+        &[
+            &["clean", "apply", path(&walk), "-o", path(&without)][..],
+            &filter,
+        ]
+        .concat(),
+    );
+    same_as_feet_command(&with, &without, "clean");
+
+    // style.
+    let (with, without) = (file("style-feet.bvh"), file("style.bvh"));
+    let style_args = ["style", "apply", path(&walk), "--style", path(&style), "-o"];
+    mocap_ok(&[&style_args[..], &[path(&with), "--feet"]].concat());
+    mocap_ok(&[&style_args[..], &[path(&without)]].concat());
+    same_as_feet_command(&with, &without, "style");
+
+    // fuse run, on a simulated capture of the walk.
+    let sim = file("sim");
+    mocap_ok(&["-q", "fuse", "simulate", path(&walk), "-o", path(&sim)]);
+    let recordings: Vec<String> = (0..3)
+        .map(|s| path(&sim.join(format!("sensor-{s}.jsonl"))).to_string())
+        .collect();
+    let calib = sim.join("truth.calib.toml");
+    let body = sim.join("body.json");
+    let (with, without) = (file("fused-feet.bvh"), file("fused.bvh"));
+    let run = |output: &Path, extra: &[&str]| {
+        let mut args = vec!["fuse", "run"];
+        args.extend(recordings.iter().map(String::as_str));
+        args.extend([
+            "--calib",
+            path(&calib),
+            "--body",
+            path(&body),
+            "-o",
+            path(output),
+        ]);
+        args.extend(extra);
+        mocap_ok(&args)
+    };
+    let out = run(&with, &["--feet", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let feet = &report["outputs"][0]["feet"];
+    assert_eq!(feet["after"]["below_floor"]["frames_below"], 0, "{feet}");
+    run(&without, &[]);
+    same_as_feet_command(&with, &without, "fuse run");
+}

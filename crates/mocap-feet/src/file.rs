@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use mocap_core::bodymap::BodyMap;
 use mocap_core::io::{read_motion, write_motion};
-use mocap_core::{Error, Result};
+use mocap_core::{Error, Motion, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::plant::{plant_feet, FeetOptions, FeetReport};
@@ -35,13 +35,24 @@ pub fn plant_feet_file(
         Error::Invalid(message) => Error::Invalid(format!("{}: {message}", input.display())),
         other => other,
     };
-    let map = BodyMap::detect(motion.skeleton()).map_err(named)?;
-    let (planted, report) = plant_feet(&motion, &map, options).map_err(named)?;
+    let (planted, rig, report) = plant_feet_detected(&motion, options).map_err(named)?;
     write_motion(output, &planted)?;
     Ok(FeetFileReport {
         input: input.to_path_buf(),
         output: output.to_path_buf(),
-        rig: map.rig().to_string(),
+        rig,
         report,
     })
+}
+
+/// [`plant_feet`] with the body parts found by [`BodyMap::detect`]; also
+/// returns the rig they were found with. What another command's `--feet`
+/// runs on its output before writing it.
+pub fn plant_feet_detected(
+    motion: &Motion,
+    options: &FeetOptions,
+) -> Result<(Motion, String, FeetReport)> {
+    let map = BodyMap::detect(motion.skeleton())?;
+    let (planted, report) = plant_feet(motion, &map, options)?;
+    Ok((planted, map.rig().to_string(), report))
 }

@@ -63,6 +63,7 @@
 //!         paths: vec!["fused.bvh".into()],
 //!         bvh_units_per_metre: 100.0,
 //!         bvh_lengths: BoneLengthSource::Fused,
+//!         feet: None,
 //!     },
 //!     fusion: FusionOptions::best(),
 //!     fps: 30.0,

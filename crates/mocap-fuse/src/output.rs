@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use mocap_core::io::atomic::AtomicFile;
 use mocap_core::{Error, Result};
+use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
 use serde::Serialize;
 
 use crate::body::BodyModel;
@@ -132,6 +133,9 @@ pub struct OutputReport {
     /// For a BVH: forward kinematics of the file as written (read back) vs
     /// the fused joints.
     pub fit_error: Option<FitError>,
+    /// For a BVH with [`OutputFiles::feet`]: what the feet stage did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feet: Option<FeetReport>,
 }
 
 /// The files fused frames go to (`mocap fuse run` and `serve`), and how the
@@ -145,6 +149,9 @@ pub struct OutputFiles {
     pub bvh_units_per_metre: f32,
     /// Where the BVH skeleton's bone lengths come from.
     pub bvh_lengths: BoneLengthSource,
+    /// Hold planted feet still and above the floor in the BVH files
+    /// (mocap-feet, as `mocap feet`).
+    pub feet: Option<FeetOptions>,
 }
 
 /// Fused frames to several outputs at once.
@@ -156,6 +163,7 @@ pub struct FusedOutputs {
     body: BodyModel,
     bvh_options: BvhOptions,
     lengths: BoneLengthSource,
+    feet: Option<FeetOptions>,
     reports: Vec<OutputReport>,
 }
 
@@ -179,6 +187,7 @@ impl FusedOutputs {
             body,
             bvh_options,
             lengths: BoneLengthSource::Fused,
+            feet: None,
             reports: Vec::new(),
         })
     }
@@ -189,8 +198,10 @@ impl FusedOutputs {
             units_per_metre: files.bvh_units_per_metre,
             fps,
         };
-        Ok(FusedOutputs::create(&files.paths, body, bvh_options)?
-            .with_bone_lengths(files.bvh_lengths))
+        let mut outputs = FusedOutputs::create(&files.paths, body, bvh_options)?
+            .with_bone_lengths(files.bvh_lengths);
+        outputs.feet = files.feet;
+        Ok(outputs)
     }
 
     /// Where the BVH outputs' bone lengths come from (default: the fused
@@ -226,6 +237,7 @@ impl FrameSink for FusedOutputs {
                 format: OutputFormat::Jsonl,
                 frames: self.written,
                 fit_error: None,
+                feet: None,
             });
         }
         self.jsonl.clear();
@@ -239,6 +251,15 @@ impl FrameSink for FusedOutputs {
         }
         let motion =
             fused_to_motion_with(&self.frames, &self.body, &self.bvh_options, self.lengths)?;
+        let (motion, feet) = match &self.feet {
+            Some(options) => {
+                let (planted, _, report) = plant_feet_detected(&motion, options).map_err(|e| {
+                    Error::Invalid(format!("the feet stage (--feet) on the fused take: {e}"))
+                })?;
+                (planted, Some(report))
+            }
+            None => (motion, None),
+        };
         let poses = regular_poses(&self.frames, self.bvh_options.fps);
         for path in std::mem::take(&mut self.bvh) {
             mocap_core::io::bvh::write_bvh(&path, &motion)?;
@@ -249,6 +270,7 @@ impl FrameSink for FusedOutputs {
                 format: OutputFormat::Bvh,
                 frames: motion.frame_count(),
                 fit_error: Some(error),
+                feet: feet.clone(),
             });
         }
         Ok(())

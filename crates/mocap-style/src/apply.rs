@@ -33,6 +33,7 @@ use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, Vec3};
 use mocap_core::Motion;
 use mocap_core::Skeleton;
+use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -80,6 +81,10 @@ pub struct ApplyOptions {
     /// so turns stay turns; [`Asymmetry`]).
     #[serde(default)]
     pub asymmetry: Asymmetry,
+    /// Then hold planted feet still and above the floor on the written
+    /// take (mocap-feet, as `mocap feet`).
+    #[serde(default)]
+    pub feet: Option<FeetOptions>,
     pub device: DeviceChoice,
 }
 
@@ -103,6 +108,7 @@ impl ApplyOptions {
             root: RootPath::default(),
             asymmetry: Asymmetry::default(),
             foot_contacts: false,
+            feet: None,
             device: DeviceChoice::Cpu,
         }
     }
@@ -478,6 +484,9 @@ pub struct ApplyReport {
     /// rig), and frames held back by the leg's reach.
     #[serde(default)]
     pub contacts: Option<ContactReport>,
+    /// What the feet stage did on the written take (with `feet`).
+    #[serde(default)]
+    pub feet: Option<FeetReport>,
     pub asymmetry: Asymmetry,
     /// Seconds over which the source's asymmetry was averaged (two of its
     /// strides, [`Asymmetry::Source`]); `None`: over the whole clip (a
@@ -767,6 +776,18 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         Some(back) => back.apply(&restyled.motion)?,
         None => restyled.motion.clone(),
     };
+    let (output, feet) = match &options.feet {
+        Some(feet) => {
+            let (planted, _, report) = plant_feet_detected(&output, feet).map_err(|e| {
+                invalid(format!(
+                    "{}: the feet stage (--feet) on the restyled take: {e}",
+                    options.source.display()
+                ))
+            })?;
+            (planted, Some(report))
+        }
+        None => (output, None),
+    };
     let t = Instant::now();
     write_motion(&options.out, &output)?;
     let write_seconds = t.elapsed().as_secs_f64();
@@ -805,6 +826,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         root_shift: restyled.root_shift,
         contacts: restyled.contacts,
         foot_contacts: options.foot_contacts,
+        feet,
         asymmetry: options.asymmetry,
         asymmetry_window_s: restyled.asymmetry_window_s,
         source_frames: source.frame_count(),

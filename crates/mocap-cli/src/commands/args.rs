@@ -14,6 +14,23 @@ use std::path::PathBuf;
 
 use mocap_nn::device::DeviceChoice;
 
+/// `--feet`: the stage of `mocap feet` run on a command's output before it
+/// is written.
+#[derive(clap::Args, Clone, Debug)]
+pub struct FeetArgs {
+    /// Then hold the output's planted feet still and above the floor, as `mocap feet` does
+    /// (body parts found by joint name or `--rig`).
+    #[arg(long)]
+    pub feet: bool,
+}
+
+impl FeetArgs {
+    /// The feet stage's options, when asked for.
+    pub fn options(&self) -> Option<mocap_feet::FeetOptions> {
+        self.feet.then(mocap_feet::FeetOptions::default)
+    }
+}
+
 /// `--device`: where the networks run.
 #[derive(clap::Args, Clone, Debug)]
 pub struct DeviceArgs {

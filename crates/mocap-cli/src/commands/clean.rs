@@ -11,7 +11,7 @@ use mocap_clean::{
     TrainOptions, TrainRecipe, WienerFitOptions,
 };
 
-use super::args::{set, DeviceArgs, ReportArgs, TrainLoopArgs};
+use super::args::{set, DeviceArgs, FeetArgs, ReportArgs, TrainLoopArgs};
 use super::{write_output, GlobalOptions};
 
 #[derive(clap::Args)]
@@ -71,6 +71,8 @@ struct CleanApplyArgs {
     /// Spike finding: the longest spike looked for, in frames (default 90).
     #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
     despike_max_frames: Option<usize>,
+    #[command(flatten)]
+    feet: FeetArgs,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
@@ -263,6 +265,7 @@ fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         device: a.device.device,
         hop: a.hop,
         despike,
+        feet: a.feet.options(),
     })?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -284,6 +287,9 @@ fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             };
             eprintln!("bridged {} spikes {when}", report.spikes.len());
             list_spikes(&report.spikes);
+        }
+        if let Some(feet) = &report.feet {
+            eprintln!("{}", super::feet::summary(feet));
         }
     }
     Ok(())

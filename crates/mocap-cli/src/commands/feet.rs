@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use mocap_feet::{plant_feet_file, FeetOptions};
+use mocap_feet::{plant_feet_file, FeetOptions, FeetReport};
 
 use super::GlobalOptions;
 
@@ -95,4 +95,18 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// One line on what the feet stage did, for the commands with `--feet`.
+pub fn summary(r: &FeetReport) -> String {
+    let leg = r.before.leg_length as f64;
+    format!(
+        "feet: planted-foot sliding {:.1} -> {:.1}% of the leg a second; frames with a foot below \
+         the floor {} -> {}; jitter {:+.1}%",
+        100.0 * r.before.sliding / leg,
+        100.0 * r.after.sliding / leg,
+        r.before.below_floor.frames_below,
+        r.after.below_floor.frames_below,
+        100.0 * (r.after.jitter / r.before.jitter - 1.0)
+    )
 }

@@ -14,7 +14,7 @@ use mocap_fuse::{
 };
 use serde::Serialize;
 
-use super::args::ReportArgs;
+use super::args::{FeetArgs, ReportArgs};
 use super::GlobalOptions;
 
 #[derive(clap::Args)]
@@ -92,6 +92,8 @@ struct FusedBvhArgs {
     /// Bone lengths of the BVH skeleton: the median of the fused take, or the body file's.
     #[arg(long, default_value = "fused", value_parser = ["fused", "body"])]
     bvh_lengths: String,
+    #[command(flatten)]
+    feet: FeetArgs,
 }
 
 impl FusedBvhArgs {
@@ -110,6 +112,7 @@ impl FusedBvhArgs {
             paths,
             bvh_units_per_metre,
             bvh_lengths,
+            feet: self.feet.options(),
         })
     }
 }
@@ -392,6 +395,9 @@ fn print_outputs(outputs: &[OutputReport]) {
                 e.max_mm
             ),
             None => println!("  {}: {} frames", o.path.display(), o.frames),
+        }
+        if let Some(feet) = &o.feet {
+            println!("  {}", super::feet::summary(feet));
         }
     }
 }

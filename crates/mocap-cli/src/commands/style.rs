@@ -9,7 +9,7 @@ use mocap_style::{
     RootPath, StyleJudge, TrainOptions,
 };
 
-use super::args::{set, DeviceArgs, ReportArgs, TrainLoopArgs};
+use super::args::{set, DeviceArgs, FeetArgs, ReportArgs, TrainLoopArgs};
 use super::{write_output, GlobalOptions};
 
 #[derive(clap::Args)]
@@ -134,6 +134,8 @@ struct ApplyArgs {
     #[command(flatten)]
     restyle: RestyleArgs,
     #[command(flatten)]
+    feet: FeetArgs,
+    #[command(flatten)]
     device: DeviceArgs,
     /// Print what was done (timing, patches, root, retargeting, stage times) as JSON.
     #[arg(long)]
@@ -235,6 +237,7 @@ fn apply_options(a: &ApplyArgs) -> anyhow::Result<ApplyOptions> {
     options.root = a.restyle.root;
     options.foot_contacts = a.restyle.foot_contacts;
     options.asymmetry = a.restyle.asymmetry;
+    options.feet = a.feet.options();
     options.device = a.device.device;
     Ok(options)
 }
@@ -317,6 +320,9 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
                     report.time_scale,
                     report.distance_ratio
                 );
+                if let Some(feet) = &report.feet {
+                    eprintln!("{}", super::feet::summary(feet));
+                }
             }
         }
         StyleCommand::Eval(a) => {
