@@ -23,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         device: Default::default(),
         hop: None,
         despike: None,
+        root_filter: None,
         feet: None,
     };
     let mut i = 2;

@@ -18,6 +18,7 @@
 //! - [`Filter::OneEuro`]: the One Euro filter (Casiez, Roussel, Vogel,
 //!   CHI 2012), a causal low-pass whose cutoff rises with speed.
 
+use mocap_core::rotation::Vec3;
 use mocap_core::Motion;
 use sci_rs::signal::filter::design::{butter_dyn, DigitalFilter, FilterBandType, FilterOutputType};
 use sci_rs::signal::filter::{savgol_coeffs_dyn, sosfiltfilt_dyn};
@@ -272,6 +273,28 @@ pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
             .expect("a layout of local 6D rotations");
         filter_features(&mut features, 6, filter, fps);
         layout.decode_joint_into(&features, k, &mut out);
+    }
+    Ok(out)
+}
+
+/// Filters the translations of the joints with position channels (the
+/// root's, and Bandai's pelvis) of `motion`, each axis on its own; rotations
+/// are left as they are. Optical captures' roots are clean, but a fused
+/// capture's root is as noisy as any joint, and most of its jitter is there
+/// (docs/research/clean.md, "Fused captures").
+pub fn filter_translations(motion: &Motion, filter: &Filter) -> Result<Motion> {
+    let fps = motion.fps() as f32;
+    filter.validate(fps)?;
+    let mut out = motion.clone();
+    let skeleton = motion.skeleton();
+    for j in (0..skeleton.joint_count()).filter(|&j| skeleton.joint(j).has_position_channels()) {
+        let mut xyz: Vec<f32> = (0..motion.frame_count())
+            .flat_map(|f| motion.local_translation(f, j).to_array())
+            .collect();
+        filter_features(&mut xyz, 3, filter, fps);
+        for (f, p) in xyz.chunks_exact(3).enumerate() {
+            out.set_local_translation(f, j, Vec3::from_slice(p));
+        }
     }
     Ok(out)
 }

@@ -32,7 +32,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
 use crate::features::Representation;
-use crate::filters::{filter_motion, Filter};
+use crate::filters::{filter_motion, filter_translations, Filter};
 use crate::metrics::rotation_error_deg;
 use crate::model_file::{window_base, with_base_input, Base, CleanModel, ModelFile};
 use crate::wiener::WienerOutcome;
@@ -289,6 +289,11 @@ pub struct CleanOptions {
     /// ([`crate::remove_spikes`]).
     #[serde(default)]
     pub despike: Option<DespikeOptions>,
+    /// Also filter the translations (the root's) with this filter
+    /// ([`crate::filter_translations`]): what a fused capture needs, whose
+    /// root is as noisy as its joints. `None` keeps them.
+    #[serde(default)]
+    pub root_filter: Option<Filter>,
     /// Then hold planted feet still and above the floor (mocap-feet).
     #[serde(default)]
     pub feet: Option<FeetOptions>,
@@ -393,6 +398,13 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                 start.elapsed().as_secs_f64(),
             )
         }
+    };
+    let (cleaned, method) = match &options.root_filter {
+        Some(filter) => (
+            filter_translations(&cleaned, filter)?,
+            format!("{method}; root: {}", filter.label()),
+        ),
+        None => (cleaned, method),
     };
     let (cleaned, feet) = match &options.feet {
         Some(feet) => {
@@ -749,6 +761,7 @@ mod tests {
             device: DeviceChoice::Cpu,
             hop: None,
             despike: Some(despike),
+            root_filter: None,
             feet: None,
         })
         .unwrap();

@@ -40,6 +40,7 @@
 //!     device: Default::default(),
 //!     hop: None,
 //!     despike: None,
+//!     root_filter: None,
 //!     feet: None,
 //! })?;
 //! println!("{} frames, {:.2} degrees changed", report.frames, report.mean_change_deg);
@@ -122,7 +123,9 @@ pub use eval::{
     SpikeSurvival, TunedFilter, CONDITIONS,
 };
 pub use features::{FeatureLayout, Recentering, Representation, RotationFrame};
-pub use filters::{filter_features, filter_motion, gcv_score, gcv_trace_fraction, Filter};
+pub use filters::{
+    filter_features, filter_motion, filter_translations, gcv_score, gcv_trace_fraction, Filter,
+};
 pub use infer::{clean_file, BridgedSpike, CleanOptions, CleanReport, Method};
 pub use loss::LossWeights;
 pub use metrics::{position_errors, rotation_error_deg};

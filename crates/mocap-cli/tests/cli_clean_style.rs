@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use mocap_core::io::bvh::read_bvh;
+use mocap_core::io::bvh::{read_bvh, write_bvh};
+use mocap_core::rotation::Vec3;
 use mocap_style::{foot_skating, planted_foot_sliding, RigLayout};
 
 fn mocap(args: &[&str]) -> Output {
@@ -160,6 +161,61 @@ fn clean_with_a_filter_and_bad_inputs() {
     // Without -o it is a usage error.
     let out = mocap(&["clean", "apply", &input]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// Mean jerk of the pelvis' translation channels (file units per frame³).
+fn pelvis_jerk(file: &Path) -> f32 {
+    let m = read_bvh(file).unwrap();
+    let pelvis = 1; // Bandai's Hips, under the still joint_Root.
+    let x: Vec<_> = (0..m.frame_count())
+        .map(|f| m.local_translation(f, pelvis))
+        .collect();
+    let jerks: Vec<f32> = x
+        .windows(4)
+        .map(|w| (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).length())
+        .collect();
+    jerks.iter().sum::<f32>() / jerks.len() as f32
+}
+
+/// A fused capture's root is noisy: `--root-filter` cleans it, and without
+/// it the root's translation is kept as it was.
+#[test]
+fn root_filter_cleans_the_root_translation_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut walk = read_bvh(Path::new(&sample("dataset-1_walk_normal_001.bvh"))).unwrap();
+    // 1 cm of alternating noise on the pelvis, as fusion leaves it.
+    for f in 0..walk.frame_count() {
+        let t = walk.local_translation(f, 1);
+        let noise = if f % 2 == 0 { 1.0 } else { -1.0 };
+        walk.set_local_translation(f, 1, t + Vec3::new(noise, 0.0, noise));
+    }
+    let input = dir.path().join("noisy-root.bvh");
+    write_bvh(&input, &walk).unwrap();
+    let clean = |name: &str, extra: &[&str]| {
+        let output = dir.path().join(name);
+        let out = mocap(
+            &[
+                &["clean", "apply", path(&input), "-o", path(&output)][..],
+                &["--filter", "butterworth:2:3", "--json"],
+                extra,
+            ]
+            .concat(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (output, report["method"].as_str().unwrap().to_string())
+    };
+    let (kept, method) = clean("kept.bvh", &[]);
+    assert!(!method.contains("root"), "{method}");
+    let (filtered, method) = clean("root.bvh", &["--root-filter", "butterworth:2:3"]);
+    assert!(method.contains("root: butterworth"), "{method}");
+    let noisy = pelvis_jerk(&input);
+    assert!((pelvis_jerk(&kept) - noisy).abs() < 1e-3 * noisy);
+    assert!(
+        pelvis_jerk(&filtered) < 0.1 * noisy,
+        "{} of {noisy}",
+        pelvis_jerk(&filtered)
+    );
 }
 
 #[test]

@@ -1,10 +1,13 @@
 //! Stage 2: the fused take of stage 1, on the sample's rig, cleaned by the
 //! shipped denoiser, no noise added: the noise is what the sensors and the
-//! fusion made. A classical filter (zero-phase Butterworth, cutoff chosen by
-//! generalised cross-validation on the take itself) runs beside it, and the
-//! three takes (fused, cleaned, filtered) are compared with the sample.
+//! fusion made. The denoiser cleans the rotations; a fused take's root is
+//! as noisy as its joints, so its translation goes through a 3 Hz
+//! Butterworth (as `mocap clean apply --root-filter butterworth:2:3`). A
+//! classical filter alone (the same Butterworth on the rotations and the
+//! root) runs beside it, and the three takes (fused, cleaned, filtered) are
+//! compared with the sample.
 
-use mocap_clean::{filter_motion, CleanModel, Filter};
+use mocap_clean::{filter_motion, filter_translations, CleanModel, Filter};
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::angle_between;
 use mocap_core::Motion;
@@ -64,10 +67,15 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     let fused = read_bvh(&take.path)?;
     let model = CleanModel::load(&options.clean_model, DeviceChoice::Cpu)?;
     let started = std::time::Instant::now();
-    let cleaned = model.clean(&fused, None)?;
+    // 3 Hz: docs/research/clean.md, "Fused captures" (the cross-validated
+    // cutoff takes this smooth noise for motion).
+    let filter = Filter::Butterworth {
+        order: 2,
+        cutoff_hz: 3.0,
+    };
+    let cleaned = filter_translations(&model.clean(&fused, None)?, &filter)?;
     let clean_seconds = started.elapsed().as_secs_f64();
-    let filter = Filter::ButterworthGcv { order: 2 };
-    let filtered = filter_motion(&fused, &filter)?;
+    let filtered = filter_translations(&filter_motion(&fused, &filter)?, &filter)?;
 
     let cleaned_path = context.path("clean", "cleaned.bvh")?;
     let filtered_path = context.path("clean", "filtered.bvh")?;
@@ -75,11 +83,11 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     write_bvh(&filtered_path, &filtered)?;
     report.output(
         StageContext::relative("clean", "cleaned.bvh"),
-        "the fused take cleaned by the denoiser: what the next stages get",
+        "the fused take cleaned by the denoiser, its root by a 3 Hz Butterworth: what the next stages get",
     );
     report.output(
         StageContext::relative("clean", "filtered.bvh"),
-        "the fused take through the classical filter, for comparison",
+        "the fused take through a 3 Hz Butterworth (rotations and root), for comparison",
     );
     report.viewer_command = Some(viewer_command(&[
         &options.sample,
@@ -108,7 +116,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     );
     report.number(
         "clean_seconds",
-        "time the model took to clean the take (CPU)",
+        "time the model (and the root's filter) took to clean the take (CPU)",
         clean_seconds,
         "s",
     );

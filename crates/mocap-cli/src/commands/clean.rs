@@ -37,7 +37,8 @@ enum CleanCommand {
 struct CleanApplyArgs {
     /// The take to clean (BVH).
     input: PathBuf,
-    /// The cleaned take (BVH: same skeleton and channel layout, root translation kept).
+    /// The cleaned take (BVH: same skeleton and channel layout; root translation kept unless
+    /// --root-filter).
     #[arg(long, short)]
     output: PathBuf,
     /// A file written by `mocap clean train` or `mocap clean fit-wiener`
@@ -71,6 +72,11 @@ struct CleanApplyArgs {
     /// Spike finding: the longest spike looked for, in frames (default 90).
     #[arg(long, requires = "despike", value_name = "FRAMES", value_parser = frames_at_least_one)]
     despike_max_frames: Option<usize>,
+    /// Also filter the root's translation with this filter (same SPEC as --filter; e.g.
+    /// butterworth:2:3 for a fused capture, whose root is as noisy as its joints; by default the
+    /// root's translation is kept).
+    #[arg(long, value_name = "SPEC")]
+    root_filter: Option<Filter>,
     #[command(flatten)]
     feet: FeetArgs,
     /// Print the report as JSON on standard output.
@@ -265,6 +271,7 @@ fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         device: a.device.device,
         hop: a.hop,
         despike,
+        root_filter: a.root_filter,
         feet: a.feet.options(),
     })?;
     if a.json {
