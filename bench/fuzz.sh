@@ -75,6 +75,10 @@ done
     echo "| --- | --- | ---: | ---: | ---: | ---: | ---: |"
     cat "$rows"/*.md
     echo
+    echo "model_file is slow by nature: each input is a whole model file (the seeds are 1 and 2.4 MB), loaded"
+    echo "twice, so ten minutes try about two thousand files against millions of datagrams or requests."
+    echo "Two targets ran at once, one per core."
+    echo
     echo "Crashes these targets found, each kept as a regression test in crates/mocap-core/tests/fuzz_regressions.rs:"
     echo
     echo "- bvh (after 146,038 executions): a JOINT name holding NUL and CR bytes could be read but not written"
