@@ -13,7 +13,7 @@
 //!    with the ground truth, written as a BVH on a fitted skeleton, and
 //!    retargeted onto the sample's rig for the next stages;
 //! 2. **clean** ([`clean`]): the shipped denoiser cleans that fused take,
-//!    with a classical filter (cross-validated Butterworth) beside it;
+//!    a 3 Hz Butterworth its root, with the same filter alone beside it;
 //! 3. **feet** ([`feet`]): planted feet held still and above the floor
 //!    (mocap-feet);
 //! 4. **search** ([`search`]): a small library index (Bandai dataset-2,
@@ -213,7 +213,7 @@ pub struct OutputFile {
 /// What one stage did.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StageReport {
-    /// `fuse`, `clean`, `search` or `style`.
+    /// `fuse`, `clean`, `feet`, `search` or `style`.
     pub name: String,
     pub title: String,
     pub status: StageStatus,
