@@ -410,10 +410,9 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         Some(feet) => {
             let (planted, _, report) =
                 plant_feet_detected(&cleaned, feet).map_err(|e| match e {
-                    mocap_core::Error::Invalid(m) => CleanError::Invalid(format!(
-                        "{}: the feet stage (--feet): {m}",
-                        options.input.display()
-                    )),
+                    mocap_core::Error::Invalid(m) => {
+                        CleanError::Invalid(format!("{}: --feet: {m}", options.input.display()))
+                    }
                     other => other.into(),
                 })?;
             (planted, Some(report))

@@ -85,6 +85,26 @@ fn feet_refuses_a_take_too_short_and_writes_nothing() {
         "{text}"
     );
     assert!(!output.exists());
+
+    // The same through another command's --feet: which option, why, and
+    // nothing written.
+    let out = mocap(&[
+        "clean",
+        "apply",
+        path(&input),
+        "-o",
+        path(&output),
+        "--filter",
+        "butterworth:2:3",
+        "--feet",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        text.contains("short.bvh: --feet: ") && text.contains("has 2"),
+        "{text}"
+    );
+    assert!(!output.exists());
 }
 
 #[test]

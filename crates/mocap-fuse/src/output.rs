@@ -253,9 +253,8 @@ impl FrameSink for FusedOutputs {
             fused_to_motion_with(&self.frames, &self.body, &self.bvh_options, self.lengths)?;
         let (motion, feet) = match &self.feet {
             Some(options) => {
-                let (planted, _, report) = plant_feet_detected(&motion, options).map_err(|e| {
-                    Error::Invalid(format!("the feet stage (--feet) on the fused take: {e}"))
-                })?;
+                let (planted, _, report) = plant_feet_detected(&motion, options)
+                    .map_err(|e| Error::Invalid(format!("--feet, on the fused take: {e}")))?;
                 (planted, Some(report))
             }
             None => (motion, None),

@@ -780,7 +780,7 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         Some(feet) => {
             let (planted, _, report) = plant_feet_detected(&output, feet).map_err(|e| {
                 invalid(format!(
-                    "{}: the feet stage (--feet) on the restyled take: {e}",
+                    "{}: --feet, on the restyled take: {e}",
                     options.source.display()
                 ))
             })?;
