@@ -188,6 +188,13 @@ fn demo_runs_the_fused_take_through_the_whole_chain() {
     let on_rig = number(fuse, "on_rig_position_error_mm");
     assert!(on_rig > 0.0 && on_rig < 200.0, "{on_rig} mm");
 
+    // The page shows the chain's errors, the fused take's first.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let table = &html[html
+        .find("The take through the chain")
+        .expect("the chain table")..];
+    assert!(table.contains(&format!("{on_rig:.2}")), "{on_rig}");
+
     let clean = stage(&report, "clean");
     assert_eq!(clean["status"], "ran", "{clean}");
     assert!(fact(clean, "input").ends_with("fused-on-sample-rig.bvh"));

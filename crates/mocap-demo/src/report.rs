@@ -80,6 +80,7 @@ pub fn html(report: &DemoReport) -> String {
         );
     }
     h.push_str("</table>\n");
+    chain_table(&mut h, report);
     for s in &report.stages {
         let _ = writeln!(
             h,
@@ -156,6 +157,64 @@ pub fn html(report: &DemoReport) -> String {
          CC BY-NC 4.0; see <code>samples/README.md</code>.</p>\n</body></html>\n",
     );
     h
+}
+
+/// The take after each stage of the chain against the sample, one row a
+/// stage (`-` where the stage did not run).
+const CHAIN_ROWS: &[(&str, &str, &str, &str)] = &[
+    (
+        "fused, on the sample's rig",
+        "fuse",
+        "on_rig_position_error_mm",
+        "on_rig_jitter",
+    ),
+    (
+        "cleaned",
+        "clean",
+        "position_error_cleaned_mm",
+        "jitter_cleaned",
+    ),
+    (
+        "feet planted",
+        "feet",
+        "position_error_after_mm",
+        "jitter_after",
+    ),
+];
+
+fn chain_table(h: &mut String, report: &DemoReport) {
+    let value = |stage: &str, number: &str| {
+        report
+            .stage(stage)
+            .and_then(|s| s.value(number))
+            .map_or_else(|| "-".to_string(), format_value)
+    };
+    h.push_str(
+        "<h2 id=\"chain\">The take through the chain</h2>\n<p>Each stage works on the output of the \
+         stage before it; errors against the sample, at the same instants.</p>\n<table><tr><th>take</th>\
+         <th>position error (mm)</th><th>jitter (mm/frame³)</th></tr>\n",
+    );
+    for (label, stage, position, jitter) in CHAIN_ROWS {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td></tr>",
+            escape(label),
+            value(stage, position),
+            value(stage, jitter)
+        );
+    }
+    let _ = writeln!(
+        h,
+        "<tr><td>the sample</td><td class=\"n\">0</td><td class=\"n\">{}</td></tr>\n</table>",
+        value("fuse", "sample_jitter")
+    );
+    let _ = writeln!(
+        h,
+        "<p>Planted-foot sliding (cm/s): {} before the feet stage, {} after, {} in the sample.</p>",
+        value("feet", "sliding_before_cm_s"),
+        value("feet", "sliding_after_cm_s"),
+        value("feet", "sliding_sample_cm_s")
+    );
 }
 
 fn status_class(status: StageStatus) -> &'static str {
