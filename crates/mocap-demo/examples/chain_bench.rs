@@ -38,6 +38,11 @@ const COLUMNS: &[(&str, &str, &str)] = &[
     ("feet", "sliding_before_cm_s", "before feet"),
     ("feet", "sliding_after_cm_s", "after feet"),
     ("feet", "jitter_after", "jitter after feet"),
+    (
+        "style",
+        "source_reconstruction_deg",
+        "style model's error on the take (deg)",
+    ),
 ];
 
 /// Stage times (s).
