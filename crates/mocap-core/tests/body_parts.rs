@@ -713,3 +713,22 @@ fn a_skeleton_that_is_no_body_is_refused_with_a_template() {
         assert!(err.contains(expected), "{expected}: {err}");
     }
 }
+
+/// The joint that moves the body: Bandai's hips (its root stays at the
+/// floor), a CMU take's root above the pelvis where the pelvis cannot move.
+#[test]
+fn the_position_carrier_is_the_pelvis_or_the_nearest_joint_above_it_that_moves() {
+    let walk = read_bvh(&mocap_testdata::sample_walk()).unwrap();
+    let skeleton = walk.skeleton();
+    let map = BodyMap::detect(skeleton).unwrap();
+    let carrier = map.position_carrier(skeleton).expect("Bandai moves its hips");
+    assert_eq!(skeleton.joint(carrier).name, "Hips");
+    assert_eq!(Some(carrier), map.joint(Pelvis));
+
+    // The same rig with the hips' position channels taken away: the root.
+    let mut joints = skeleton.joints().to_vec();
+    joints[carrier].channels.retain(|c| c.is_rotation());
+    let still = Skeleton::new(joints).unwrap();
+    let map = BodyMap::detect(&still).unwrap();
+    assert_eq!(map.position_carrier(&still), Some(0));
+}

@@ -19,16 +19,15 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use anyhow::{anyhow, Context};
-use mocap_core::bodymap::{BodyMap, BodyPart};
+use mocap_core::bodymap::BodyMap;
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{Quat, Vec3};
-use mocap_core::Motion;
+use mocap_core::{forward_kinematics, Motion};
 use mocap_fuse::{
-    fit_error, fused_to_motion, poses_to_motion, regular_poses, simulate_capture,
-    truth_from_motion, views_at, BvhOptions, FusedFrame, FusionOptions, GroundTruth, MemorySink,
-    SendOptions, SendReport, SensorFrame, SensorStreams, ServeOptions, ServeReport,
-    SimulatedCapture, SimulationOptions, JOINT_COUNT,
+    fit_error, fused_to_motion, poses_to_motion, regular_poses, simulate_capture, views_at,
+    BvhOptions, FusedFrame, FusionOptions, MemorySink, SendOptions, SendReport, SensorFrame,
+    SensorStreams, ServeOptions, ServeReport, SimulatedCapture, SimulationOptions, JOINT_COUNT,
 };
 use mocap_view::{plot_lines, render_files, LinePlot, RenderOptions, Series};
 
@@ -98,54 +97,48 @@ const ON_RIG_FILE: &str = "fused-on-sample-rig.bvh";
 
 /// `fused` (on the skeleton fitted to the Kinect joints, in the simulator's
 /// world) on the sample's rig and in the sample's world: retargeted by the
-/// two rigs' rest poses, then with the shift `center_truth` gave the truth
-/// (centring, and the treadmill that keeps a long walk in the sensors'
-/// view) added back to the root, so that planted feet stand still again.
-/// The fused frame `i` is the sample's instant `first_time + i / fps`.
+/// two rigs' rest poses, then with `truth_shift`, what the simulator took
+/// off the truth (centring, and the treadmill that keeps a long walk in the
+/// sensors' view; metres, one per truth frame at `fps`), added back through
+/// the joint that carries the body, so that planted feet stand still
+/// again. The fused frame `i` is the sample's instant `first_time + i / fps`.
 fn on_sample_rig(
     fused: &Motion,
     sample: &Motion,
-    centred: &GroundTruth,
+    truth_shift: &[Vec3],
+    fps: f64,
     first_time: f64,
 ) -> anyhow::Result<Motion> {
     let retargeting = Retargeting::detect(fused.skeleton(), sample.skeleton())
         .context("cannot relate the fused skeleton to the sample's rig")?;
     let mut out = retargeting.apply(fused)?;
-    let raw = truth_from_motion(sample, None)?;
+    let carrier = BodyMap::detect(out.skeleton())?
+        .position_carrier(out.skeleton())
+        .ok_or_else(|| {
+            anyhow!(
+                "no joint at or above the sample's pelvis has position channels to carry the walk"
+            )
+        })?;
+    let parent = out.skeleton().joint(carrier).parent;
+    let last = truth_shift
+        .len()
+        .checked_sub(1)
+        .ok_or_else(|| anyhow!("the simulation kept no shift of the truth"))?;
+    // Moving the carrier turns no joint: its parent's rotations are those
+    // of the retargeted take.
+    let poses = forward_kinematics(&out);
     let units = units_per_metre(sample);
-    // The joint that carries the walk, as the retargeting moved it: the
-    // pelvis where it has position channels (Bandai's rig keeps its root
-    // still at the floor and moves the hips), else the root (joint 0, the
-    // first of a hierarchy). Both have no rotated parent in these rigs, so
-    // the world shift is added as it is.
-    let skeleton = out.skeleton();
-    let moved = BodyMap::detect(skeleton)?
-        .joint(BodyPart::Pelvis)
-        .filter(|&j| skeleton.joint(j).has_position_channels())
-        .unwrap_or(0);
-    if !skeleton.joint(moved).has_position_channels() {
-        return Err(anyhow!(
-            "the sample's root joint has no position channels: it cannot carry the walk"
-        ));
-    }
-    let above: Vec<usize> =
-        std::iter::successors(skeleton.joint(moved).parent, |&p| skeleton.joint(p).parent)
-            .collect();
-    if raw.frames.len() != centred.frames.len() || raw.frames.is_empty() {
-        return Err(anyhow!("the ground truth does not match the sample"));
-    }
     for f in 0..out.frame_count() {
         let t = first_time + f as f64 * out.frame_time();
-        let k = ((t * raw.fps).round().max(0.0) as usize).min(raw.frames.len() - 1);
-        // Every joint was shifted alike: the first tells the shift.
-        let shift = (raw.frames[k][0] - centred.frames[k][0]) * units;
-        // Into the axes of the moved joint's parent.
-        let turn = above
-            .iter()
-            .rev()
-            .fold(Quat::IDENTITY, |q, &p| q * out.local_rotation(f, p));
-        let translation = out.local_translation(f, moved);
-        out.set_local_translation(f, moved, translation + turn.inverse() * shift);
+        let k = ((t * fps).round().max(0.0) as usize).min(last);
+        // Into the axes of the carrier's parent.
+        let to_local = parent.map_or(Quat::IDENTITY, |p| poses.rotation(f, p).inverse());
+        let translation = out.local_translation(f, carrier);
+        out.set_local_translation(
+            f,
+            carrier,
+            translation + to_local * (truth_shift[k] * units),
+        );
     }
     Ok(out)
 }
@@ -162,6 +155,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     let SimulatedCapture {
         simulation: sim,
         body,
+        truth_shift,
     } = simulate_capture(&motion, None, &simulation)?;
     let truth = &sim.truth;
     let calibration = sim.calibration();
@@ -260,7 +254,7 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
     // The chain goes on with the fused take on the sample's rig, in the
     // sample's world (see `chain`).
     let first_time = fused[0].time;
-    let on_rig = on_sample_rig(&fused_motion, &motion, truth, first_time)?;
+    let on_rig = on_sample_rig(&fused_motion, &motion, &truth_shift, truth.fps, first_time)?;
     let on_rig_path = context.path("fuse", ON_RIG_FILE)?;
     write_bvh(&on_rig_path, &on_rig)?;
     report.output(

@@ -113,21 +113,11 @@ impl FeetRig {
                 right_foot,
             )?,
         ];
-        let pelvis = part(BodyPart::Pelvis)?;
-        let mut carrier = None;
-        let mut at = Some(pelvis);
-        while let Some(j) = at {
-            if skeleton.joint(j).has_position_channels() {
-                carrier = Some(j);
-                break;
-            }
-            at = skeleton.joint(j).parent;
-        }
         Ok(FeetRig {
             legs,
-            pelvis,
+            pelvis: part(BodyPart::Pelvis)?,
             head: part(BodyPart::Head)?,
-            carrier,
+            carrier: map.position_carrier(skeleton),
             leg_length: map.leg_length(skeleton)?,
         })
     }

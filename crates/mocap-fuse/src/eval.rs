@@ -311,6 +311,7 @@ pub fn evaluate_with(
                 let SimulatedCapture {
                     simulation: sim,
                     body,
+                    ..
                 } = simulate_capture(&motion, options.units_per_metre, &sim_options)?;
                 let truth = &sim.truth;
                 let streams =

@@ -294,11 +294,12 @@ fn gaussian3(rng: &mut StdRng) -> Vec3 {
 
 /// Removes the straight-line drift of the root when the take travels further
 /// than `limit` metres (see [`SimulationOptions::treadmill_above`]), and
-/// centres the take on the origin horizontally.
-pub fn center_truth(truth: &mut GroundTruth, treadmill_above: Option<f32>) {
+/// centres the take on the origin horizontally. Returns the shift taken off
+/// each frame (metres): added back, it puts the take where it was.
+pub fn center_truth(truth: &mut GroundTruth, treadmill_above: Option<f32>) -> Vec<Vec3> {
     let n = truth.frames.len();
     if n == 0 {
-        return;
+        return Vec::new();
     }
     let roots: Vec<Vec3> = truth.frames.iter().map(|f| f[SPINE_BASE]).collect();
     let (min, max) = roots.iter().fold(
@@ -323,12 +324,15 @@ pub fn center_truth(truth: &mut GroundTruth, treadmill_above: Option<f32>) {
         _ => Vec3::ZERO,
     };
     let tm = (n - 1) as f32 / 2.0;
-    for (i, frame) in truth.frames.iter_mut().enumerate() {
-        let shift = mean * Vec3::new(1.0, 0.0, 1.0) + velocity * (i as f32 - tm);
+    let shifts: Vec<Vec3> = (0..n)
+        .map(|i| mean * Vec3::new(1.0, 0.0, 1.0) + velocity * (i as f32 - tm))
+        .collect();
+    for (frame, shift) in truth.frames.iter_mut().zip(&shifts) {
         for p in frame.iter_mut() {
-            *p -= shift;
+            *p -= *shift;
         }
     }
+    shifts
 }
 
 /// A take watched by simulated sensors, with the person measured beforehand.
@@ -340,6 +344,9 @@ pub struct SimulatedCapture {
     /// The person measured from a second capture of the take
     /// ([`measure_person`]).
     pub body: BodyModel,
+    /// What [`center_truth`] took off each frame of the truth (metres):
+    /// added back, a fused frame stands where the take stood.
+    pub truth_shift: Vec<Vec3>,
 }
 
 /// The simulation pipeline, as `mocap fuse simulate`, `mocap fuse eval` and
@@ -355,10 +362,14 @@ pub fn simulate_capture(
     options: &SimulationOptions,
 ) -> Result<SimulatedCapture> {
     let mut truth = truth_from_motion(motion, units_per_metre)?;
-    center_truth(&mut truth, options.treadmill_above);
+    let truth_shift = center_truth(&mut truth, options.treadmill_above);
     let simulation = simulate(&truth, options);
     let body = measure_person(&truth, options);
-    Ok(SimulatedCapture { simulation, body })
+    Ok(SimulatedCapture {
+        simulation,
+        body,
+        truth_shift,
+    })
 }
 
 /// The person as `mocap fuse measure` would measure them beforehand: bone

@@ -571,6 +571,16 @@ impl BodyMap {
         })
     }
 
+    /// The joint whose position channels carry the body through the world:
+    /// the pelvis, or its nearest ancestor with position channels (Bandai's
+    /// rig moves its hips and keeps its root still at the floor; most rigs
+    /// move the root above the pelvis). `None` when the rig has no pelvis or
+    /// nothing above it can move.
+    pub fn position_carrier(&self, skeleton: &Skeleton) -> Option<usize> {
+        std::iter::successors(self.joint(BodyPart::Pelvis), |&j| skeleton.joint(j).parent)
+            .find(|&j| skeleton.joint(j).has_position_channels())
+    }
+
     /// Rest length of the legs, hip to knee to ankle, averaged over both
     /// legs ([`Skeleton::chain_length`], in file units): the scale of strides
     /// and root heights between performers and rigs.
