@@ -26,7 +26,7 @@ use std::time::Instant;
 use burn::tensor::{Tensor, TensorData};
 use mocap_core::io::bvh::write_bvh;
 use mocap_core::Motion;
-use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
+use mocap_feet::{plant_feet_if_asked, FeetOptions, FeetReport};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -406,19 +406,13 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         ),
         None => (cleaned, method),
     };
-    let (cleaned, feet) = match &options.feet {
-        Some(feet) => {
-            let (planted, _, report) =
-                plant_feet_detected(&cleaned, feet).map_err(|e| match e {
-                    mocap_core::Error::Invalid(m) => {
-                        CleanError::Invalid(format!("{}: --feet: {m}", options.input.display()))
-                    }
-                    other => other.into(),
-                })?;
-            (planted, Some(report))
-        }
-        None => (cleaned, None),
-    };
+    let (cleaned, feet) =
+        plant_feet_if_asked(cleaned, options.feet.as_ref()).map_err(|e| match e {
+            mocap_core::Error::Invalid(m) => {
+                CleanError::Invalid(format!("{}: --feet: {m}", options.input.display()))
+            }
+            other => other.into(),
+        })?;
     write_bvh(&options.output, &cleaned)?;
     let frames = motion.frame_count();
     let seconds = seconds + detect_seconds;

@@ -721,7 +721,9 @@ fn the_position_carrier_is_the_pelvis_or_the_nearest_joint_above_it_that_moves()
     let walk = read_bvh(&mocap_testdata::sample_walk()).unwrap();
     let skeleton = walk.skeleton();
     let map = BodyMap::detect(skeleton).unwrap();
-    let carrier = map.position_carrier(skeleton).expect("Bandai moves its hips");
+    let carrier = map
+        .position_carrier(skeleton)
+        .expect("Bandai moves its hips");
     assert_eq!(skeleton.joint(carrier).name, "Hips");
     assert_eq!(Some(carrier), map.joint(Pelvis));
 

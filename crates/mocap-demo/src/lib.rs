@@ -531,7 +531,8 @@ pub(crate) fn viewer_command(paths: &[&Path]) -> String {
 /// Units of length per metre of a motion, from the height of its first
 /// frame (mocap-fuse's guess: centimetres, inches or metres).
 pub(crate) fn units_per_metre(motion: &mocap_core::Motion) -> f32 {
-    let poses = mocap_core::forward_kinematics(motion);
+    // The first frame only: every stage asks, for every take it compares.
+    let poses = mocap_core::kinematics::forward_kinematics_range(motion, 0..1);
     let n = motion.skeleton().joint_count();
     let (mut low, mut high) = (f32::MAX, f32::MIN);
     for j in 0..n {

@@ -46,8 +46,7 @@ pub fn plant_feet_file(
 }
 
 /// [`plant_feet`] with the body parts found by [`BodyMap::detect`]; also
-/// returns the rig they were found with. What another command's `--feet`
-/// runs on its output before writing it.
+/// returns the rig they were found with.
 pub fn plant_feet_detected(
     motion: &Motion,
     options: &FeetOptions,
@@ -55,4 +54,19 @@ pub fn plant_feet_detected(
     let map = BodyMap::detect(motion.skeleton())?;
     let (planted, report) = plant_feet(motion, &map, options)?;
     Ok((planted, map.rig().to_string(), report))
+}
+
+/// What another command's `--feet` runs on its output before writing it:
+/// [`plant_feet_detected`] when `options` is given, else `motion` as it is.
+pub fn plant_feet_if_asked(
+    motion: Motion,
+    options: Option<&FeetOptions>,
+) -> Result<(Motion, Option<FeetReport>)> {
+    match options {
+        Some(options) => {
+            let (planted, _, report) = plant_feet_detected(&motion, options)?;
+            Ok((planted, Some(report)))
+        }
+        None => Ok((motion, None)),
+    }
 }

@@ -39,7 +39,7 @@ mod ground;
 mod plant;
 
 pub use contacts::{ContactOptions, FLOOR_QUANTILE};
-pub use file::{plant_feet_detected, plant_feet_file, FeetFileReport};
+pub use file::{plant_feet_detected, plant_feet_file, plant_feet_if_asked, FeetFileReport};
 pub use floor::{
     estimate_floor, measure_feet, FeetMeasures, Floor, BELOW_FLOOR_TOLERANCE, MIN_FRAMES,
 };

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use mocap_core::io::atomic::AtomicFile;
 use mocap_core::{Error, Result};
-use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
+use mocap_feet::{plant_feet_if_asked, FeetOptions, FeetReport};
 use serde::Serialize;
 
 use crate::body::BodyModel;
@@ -251,14 +251,8 @@ impl FrameSink for FusedOutputs {
         }
         let motion =
             fused_to_motion_with(&self.frames, &self.body, &self.bvh_options, self.lengths)?;
-        let (motion, feet) = match &self.feet {
-            Some(options) => {
-                let (planted, _, report) = plant_feet_detected(&motion, options)
-                    .map_err(|e| Error::Invalid(format!("--feet, on the fused take: {e}")))?;
-                (planted, Some(report))
-            }
-            None => (motion, None),
-        };
+        let (motion, feet) = plant_feet_if_asked(motion, self.feet.as_ref())
+            .map_err(|e| Error::Invalid(format!("--feet, on the fused take: {e}")))?;
         let poses = regular_poses(&self.frames, self.bvh_options.fps);
         for path in std::mem::take(&mut self.bvh) {
             mocap_core::io::bvh::write_bvh(&path, &motion)?;

@@ -33,7 +33,7 @@ use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{angle_between, Vec3};
 use mocap_core::Motion;
 use mocap_core::Skeleton;
-use mocap_feet::{plant_feet_detected, FeetOptions, FeetReport};
+use mocap_feet::{plant_feet_if_asked, FeetOptions, FeetReport};
 use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
@@ -776,18 +776,12 @@ pub fn apply(options: &ApplyOptions) -> Result<ApplyReport> {
         Some(back) => back.apply(&restyled.motion)?,
         None => restyled.motion.clone(),
     };
-    let (output, feet) = match &options.feet {
-        Some(feet) => {
-            let (planted, _, report) = plant_feet_detected(&output, feet).map_err(|e| {
-                invalid(format!(
-                    "{}: --feet, on the restyled take: {e}",
-                    options.source.display()
-                ))
-            })?;
-            (planted, Some(report))
-        }
-        None => (output, None),
-    };
+    let (output, feet) = plant_feet_if_asked(output, options.feet.as_ref()).map_err(|e| {
+        invalid(format!(
+            "{}: --feet, on the restyled take: {e}",
+            options.source.display()
+        ))
+    })?;
     let t = Instant::now();
     write_motion(&options.out, &output)?;
     let write_seconds = t.elapsed().as_secs_f64();
