@@ -7,35 +7,22 @@
 //! `cargo run --release -p mocap-studies --example clean_fused_root -- TAKE.bvh...`
 //! (docs/research/clean.md, "Fused captures").
 
-use mocap_clean::{filter_features, filter_motion, Filter};
+use mocap_clean::{filter_motion, filter_translations, Filter};
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::{jitter, mean_joint_position_error};
 use mocap_core::ops::trim;
-use mocap_core::rotation::Vec3;
 use mocap_core::{forward_kinematics, Motion};
 use mocap_demo::{run_demo, DemoOptions};
 
 /// `motion` with `filter` on its local rotations, and on its translation
 /// channels too when `translations`.
 fn filtered(motion: &Motion, filter: &Filter, translations: bool) -> Motion {
-    let mut out = filter_motion(motion, filter).expect("a valid filter");
-    if !translations {
-        return out;
+    let out = filter_motion(motion, filter).expect("a valid filter");
+    if translations {
+        filter_translations(&out, filter).expect("a valid filter")
+    } else {
+        out
     }
-    let fps = motion.fps() as f32;
-    for j in 0..motion.skeleton().joint_count() {
-        if !motion.skeleton().joint(j).has_position_channels() {
-            continue;
-        }
-        let mut xyz: Vec<f32> = (0..motion.frame_count())
-            .flat_map(|f| motion.local_translation(f, j).to_array())
-            .collect();
-        filter_features(&mut xyz, 3, filter, fps);
-        for (f, p) in xyz.chunks_exact(3).enumerate() {
-            out.set_local_translation(f, j, Vec3::from_slice(p));
-        }
-    }
-    out
 }
 
 /// Mean joint position error (mm, the takes are in cm) and jitter

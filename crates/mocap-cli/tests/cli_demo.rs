@@ -47,6 +47,17 @@ fn number(stage: &Value, name: &str) -> f64 {
         .expect("a number")
 }
 
+fn fact<'a>(stage: &'a Value, name: &str) -> &'a str {
+    stage["facts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f[0] == name)
+        .unwrap_or_else(|| panic!("stage {} has no fact {name}", stage["name"]))[1]
+        .as_str()
+        .unwrap()
+}
+
 /// A stage that ran has finite numbers, its files exist; one that did not
 /// has a message and no numbers.
 fn check_consistent(out: &Path, stage: &Value) {
@@ -99,16 +110,8 @@ fn demo_writes_a_report_with_honest_statuses() {
     // The chain goes on without it, with the fused take.
     let feet = stage(&report, "feet");
     assert_eq!(feet["status"], "ran", "{feet}");
-    let input = feet["facts"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|f| f[0] == "input")
-        .expect("the feet stage names its input");
     assert!(
-        input[1]
-            .as_str()
-            .is_some_and(|p| p.ends_with("fused-on-sample-rig.bvh")),
+        fact(feet, "input").ends_with("fused-on-sample-rig.bvh"),
         "{feet}"
     );
 
@@ -144,25 +147,8 @@ fn demo_writes_a_report_with_honest_statuses() {
     let search = stage(&report, "search");
     if search["status"] == "ran" {
         // The bundled sample is a walk.
-        let predicted = search["facts"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|f| f[0] == "predicted")
-            .expect("a predicted class");
-        assert_eq!(predicted[1], "walk", "{search}");
+        assert_eq!(fact(search, "predicted"), "walk", "{search}");
     }
-}
-
-fn fact<'a>(stage: &'a Value, name: &str) -> &'a str {
-    stage["facts"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|f| f[0] == name)
-        .unwrap_or_else(|| panic!("stage {} has no fact {name}", stage["name"]))[1]
-        .as_str()
-        .unwrap()
 }
 
 /// The demo runs one chain: fused take -> cleaned -> feet planted ->

@@ -123,7 +123,7 @@ fn main() -> anyhow::Result<()> {
             .stage("search")
             .and_then(|s| s.facts.iter().find(|(k, _)| k == "predicted"))
             .map_or_else(|| "-".to_string(), |(_, v)| v.clone());
-        let seconds = value(&report, "fuse", "truth_frames").unwrap_or(f64::NAN) / 30.0;
+        let seconds = mocap_core::io::bvh::read_bvh(take)?.duration();
         rows.push(Row {
             take: name,
             seconds,

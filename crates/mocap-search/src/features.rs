@@ -453,13 +453,11 @@ mod tests {
         let joints = KeyJoints::detect(motion.skeleton()).unwrap();
         let parents = motion.skeleton().parents();
         let poses = forward_kinematics(&motion);
-        let base = pose_features(
-            &Positions::new(&poses.positions, poses.joint_count),
-            &joints,
-            &parents,
-            motion.fps(),
-        )
-        .unwrap();
+        let features = |poses: &GlobalPoses| {
+            let positions = Positions::new(&poses.positions, poses.joint_count);
+            pose_features(&positions, &joints, &parents, motion.fps()).unwrap()
+        };
+        let base = features(&poses);
         assert_eq!(base.dim, VALUE_COUNT);
         assert_eq!(base.frame_count(), motion.frame_count());
         let moved = transform(
@@ -468,13 +466,7 @@ mod tests {
             Vec3::new(300.0, 0.0, -120.0),
             0.62,
         );
-        let other = pose_features(
-            &Positions::new(&moved.positions, moved.joint_count),
-            &joints,
-            &parents,
-            motion.fps(),
-        )
-        .unwrap();
+        let other = features(&moved);
         // Relative to the value's size where it exceeds 1: the wrist
         // accelerations (values 74-75) are second differences of positions
         // times fps², so they carry the positions' f32 rounding times 900.
