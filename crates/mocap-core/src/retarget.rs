@@ -549,6 +549,67 @@ impl Retargeting {
         self.play(motion, Some(onto))
     }
 
+    /// A change made on the source rig carried to a take of the target rig:
+    /// `before` and `after` are motions of the source rig (e.g. `onto`
+    /// retargeted onto it, and that cleaned by a denoiser of that rig), and
+    /// each body joint of `onto` (mapped or aimed) turns in the world as
+    /// `after` turns from `before`, both played by the target rig:
+    ///
+    /// ```text
+    /// G_out(j, f) = G_after(j, f) G_before(j, f)^-1 G_onto(j, f)          (2)
+    /// ```
+    ///
+    /// The other joints (fingers, helpers, joints above the pelvis) keep
+    /// their local rotations in `onto`, as do all translations. Unlike
+    /// [`Retargeting::apply_onto`], what retargeting there and back loses
+    /// cancels: when `after` is `before`, `onto` comes back exactly; and a
+    /// joint between two mapped ones (CMU's `LHipJoint`) takes the change
+    /// of its aim without taking the other rig's bone direction.
+    pub fn carry_change(&self, before: &Motion, after: &Motion, onto: &Motion) -> Result<Motion> {
+        let frames = onto.frame_count();
+        if onto.skeleton() != &self.target
+            || before.frame_count() != frames
+            || after.frame_count() != frames
+        {
+            return Err(Error::Invalid(format!(
+                "carry_change: two motions of the source rig and one of the target rig, with \
+                 as many frames, are needed ({}, {} and {} frames)",
+                before.frame_count(),
+                after.frame_count(),
+                frames
+            )));
+        }
+        let (before, after) = (
+            forward_kinematics(&self.apply(before)?),
+            forward_kinematics(&self.apply(after)?),
+        );
+        let given = forward_kinematics(onto);
+        let mut out = onto.clone();
+        let n = self.target.joint_count();
+        let mut rotations = vec![Quat::IDENTITY; n];
+        for f in 0..frames {
+            for j in 0..n {
+                let parent_rotation = self
+                    .target
+                    .joint(j)
+                    .parent
+                    .map_or(Quat::IDENTITY, |p| rotations[p]);
+                if !matches!(self.roles[j], Role::Rest) {
+                    let change = after.rotation(f, j) * before.rotation(f, j).inverse();
+                    let global = change * given.rotation(f, j);
+                    // Euler angles nearest the take's own: unchanged joints
+                    // keep their channel values.
+                    let angles = onto.rotation_angles(f, j);
+                    let local = (parent_rotation.inverse() * global).normalize();
+                    out.set_local_rotation_near(f, j, local, Some(angles));
+                }
+                // What the channels hold (a joint may lack rotation channels).
+                rotations[j] = parent_rotation * out.local_rotation(f, j);
+            }
+        }
+        Ok(out)
+    }
+
     fn play(&self, motion: &Motion, onto: Option<&Motion>) -> Result<Motion> {
         let skeleton = motion.skeleton();
         if skeleton.joint_count() != self.source.joint_count()

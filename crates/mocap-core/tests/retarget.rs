@@ -228,6 +228,73 @@ fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
     }
 }
 
+#[test]
+fn a_change_made_on_bandai_is_carried_to_a_take_of_another_rig() {
+    let Some(data) = shared_data() else {
+        eprintln!("../shared/data is absent: skipped");
+        return;
+    };
+    let bandai = read_bvh(&sample_walk()).unwrap();
+    for rig in [
+        "dme_example_crlf_leadingdot_frametime.bvh",
+        "bvhpython_test_freebvh.bvh",
+    ] {
+        let take = read_bvh(&data.join("parser-cases").join(rig)).unwrap();
+        let take = trim(&take, 0..take.frame_count().min(60)).unwrap();
+        let on_bandai = Retargeting::detect(take.skeleton(), bandai.skeleton())
+            .unwrap()
+            .apply(&take)
+            .unwrap();
+        let back = Retargeting::detect(bandai.skeleton(), take.skeleton()).unwrap();
+        // No change: the take comes back, channel for channel, although
+        // the way there and back loses its extra joints' motion.
+        let same = back.carry_change(&on_bandai, &on_bandai, &take).unwrap();
+        for f in 0..take.frame_count() {
+            for (a, b) in take.frame(f).iter().zip(same.frame(f)) {
+                assert!((a - b).abs() < 1e-3, "{rig}: frame {f}: {a} became {b}");
+            }
+        }
+        // Bandai's left knee bent by 20 degrees more: the take's knee turns
+        // by that in the world, its thigh and its hands' fingers stay.
+        let knee_b = bandai.skeleton().find("LowerLeg_L").unwrap();
+        let mut bent = on_bandai.clone();
+        let turn = Quat::from_axis_angle(Vec3::Z, 20f32.to_radians());
+        for f in 0..bent.frame_count() {
+            let q = bent.local_rotation(f, knee_b) * turn;
+            bent.set_local_rotation(f, knee_b, q);
+        }
+        let carried = back.carry_change(&on_bandai, &bent, &take).unwrap();
+        let map = BodyMap::detect(take.skeleton()).unwrap();
+        let knee = map.joint(BodyPart::LeftKnee).unwrap();
+        let hip = map.joint(BodyPart::LeftHip).unwrap();
+        let (g_take, g_carried) = (forward_kinematics(&take), forward_kinematics(&carried));
+        let (g_before, g_after) = (forward_kinematics(&on_bandai), forward_kinematics(&bent));
+        for f in 0..take.frame_count() {
+            let wanted = g_after.rotation(f, knee_b) * g_before.rotation(f, knee_b).inverse();
+            let got = g_carried.rotation(f, knee) * g_take.rotation(f, knee).inverse();
+            let e = angle_between(wanted, got).to_degrees();
+            assert!(e < 0.1, "{rig}: frame {f}: the knee turned {e} deg off");
+            let e = angle_between(g_carried.rotation(f, hip), g_take.rotation(f, hip));
+            assert!(e.to_degrees() < 0.01, "{rig}: the thigh turned");
+        }
+        let parts: Vec<usize> = map.parts().map(|(_, j)| j).collect();
+        let body = take
+            .skeleton()
+            .subtree(map.joint(BodyPart::Pelvis).unwrap());
+        for j in (0..take.skeleton().joint_count()).filter(|j| !parts.contains(j)) {
+            let below_knee = take.skeleton().subtree(knee).contains(&j);
+            if below_knee || !body.contains(&j) {
+                continue;
+            }
+            for f in 0..take.frame_count() {
+                let e = angle_between(take.local_rotation(f, j), carried.local_rotation(f, j));
+                let name = &take.skeleton().joint(j).name;
+                assert!(e.to_degrees() < 0.01, "{rig}: {name} turned by {e}");
+            }
+        }
+    }
+}
+
 /// The pelvis of `moved` (a rig of half the size, the same joints) follows
 /// half the path of `take`'s, frame for frame.
 fn assert_pelvis_at_half(take: &Motion, moved: &Motion) {
