@@ -5,12 +5,13 @@
 //! - `RIG.bvh`: each take played by another rig (the rig of the file; the
 //!   rigs in their canonical T-poses), the noise added
 //!   on that rig, and cleaned there by the cross-validated and the 2 Hz
-//!   Butterworth, or by the shipped model through retargeting: played by
-//!   the Bandai rig, cleaned, played back onto the noisy take
-//!   (`Retargeting::apply_onto`: joints the Bandai rig lacks stay as they
-//!   were). Also the clean takes through the model (how far it moves a
-//!   clean take). Errors over every joint with rotation channels and over
-//!   the joints of body parts.
+//!   Butterworth, or by the shipped model as `mocap clean apply` runs it on
+//!   another rig: played by the Bandai rig, cleaned, the change carried
+//!   back onto the take (`Retargeting::carry_change`; joints between two
+//!   body parts by the cross-validated Butterworth, other joints untouched).
+//!   Also the clean takes through the model (how far it moves a clean
+//!   take). Errors over every joint with rotation channels and over the
+//!   joints of body parts.
 //! - `--fps F`: each take resampled to F frames per second first; the
 //!   model reading its frames as they are (what `mocap clean apply` does: the
 //!   model reads frames, not seconds), and with the take resampled to the
@@ -51,7 +52,6 @@ fn main() -> Result<(), Error> {
     );
     let takes = load_takes(&paths[..count.min(paths.len())])?;
     let model = ModelFile::Network(Box::new(CleanModel::load_default(Default::default())?));
-    let bandai = read_bvh(&mocap_testdata::sample_walk())?;
     // The take as the experiment gives it: on the other rig, or resampled.
     let given = |m: &Motion| -> Result<Motion, Error> {
         Ok(match (&rig, fps) {
@@ -60,17 +60,9 @@ fn main() -> Result<(), Error> {
             _ => unreachable!(),
         })
     };
-    // The shipped model on a given take.
-    let through_model = |m: &Motion| -> Result<Motion, Error> {
-        Ok(match &rig {
-            Some(_) => {
-                let on_bandai = Retargeting::detect(m.skeleton(), bandai.skeleton())?.apply(m)?;
-                let cleaned = model.clean(&on_bandai, None)?.0;
-                Retargeting::detect(bandai.skeleton(), m.skeleton())?.apply_onto(&cleaned, m)?
-            }
-            None => model.clean(m, None)?.0,
-        })
-    };
+    // The shipped model on a given take: a take of another rig goes through
+    // the model's own (`mocap_clean`'s `rig` module), as in `mocap clean apply`.
+    let through_model = |m: &Motion| -> Result<Motion, Error> { Ok(model.clean(m, None)?.0) };
     let mut labels = vec![
         "noisy input",
         "butterworth(order=2, cutoff=2Hz)",

@@ -35,7 +35,7 @@ use crate::dataset::{
 };
 use crate::despike::{remove_spikes, DespikeOptions};
 use crate::filters::{filter_motion, Filter};
-use crate::metrics::{position_errors, rotation_error_deg};
+use crate::metrics::{body_part_joints, position_errors, rotation_error_deg, rotation_errors_deg};
 use crate::model_file::{CleanModel, ModelFile};
 use crate::noise::{add_random_noise, add_spike_noise, add_spikes, RandomNoise, Spike, SpikeNoise};
 use crate::{CleanError, Result};
@@ -51,6 +51,10 @@ pub struct MethodMetrics {
     pub method: String,
     pub condition: String,
     pub rotation_error_deg: f64,
+    /// The rotation error over the joints of body parts alone: the joints
+    /// a model cleans on a rig not its own (the others pass through it).
+    #[serde(default)]
+    pub body_rotation_error_deg: f64,
     pub position_error: f64,
     pub acceleration_error: f64,
 }
@@ -121,6 +125,11 @@ pub struct EvalOptions {
     /// takes (see the module docs).
     #[serde(default)]
     pub despike: bool,
+    /// Also the condition [`FUSED`]: each take watched by three simulated
+    /// Kinect sensors, fused and fitted as the capture stage does it, against
+    /// its truth on the same fitted skeleton (`mocap_fuse::simulated_fused_take`).
+    #[serde(default)]
+    pub fused: bool,
     pub seed: u64,
     pub device: DeviceChoice,
 }
@@ -142,6 +151,7 @@ impl Default for EvalOptions {
             spikes: SpikeNoise::default(),
             spike_lengths: vec![2, 4, 8, 16, 32, 64],
             despike: false,
+            fused: false,
             seed: 7,
             device: DeviceChoice::Cpu,
         }
@@ -192,6 +202,47 @@ pub struct EvalReport {
 /// random noise, and spikes alone (the "spike noise" on its own:
 /// what a method does to a spike without random noise hiding its ends).
 pub const CONDITIONS: [&str; 3] = ["random", "spikes", "spikes only"];
+
+/// The condition of [`EvalOptions::fused`], after [`CONDITIONS`]: the noise
+/// the capture stage makes.
+pub const FUSED: &str = "fused";
+
+/// The conditions `options` asks for: [`CONDITIONS`], then [`FUSED`].
+fn conditions(options: &EvalOptions) -> Vec<&'static str> {
+    let mut out = CONDITIONS.to_vec();
+    if options.fused {
+        out.push(FUSED);
+    }
+    out
+}
+
+/// Take `i` of `takes` as the capture stage makes it: (truth, fused) on one
+/// fitted skeleton (see [`EvalOptions::fused`]), the sensors seeded by the
+/// evaluation's seed and the take.
+fn fused_pair(takes: &[Take], i: usize, options: &EvalOptions) -> Result<(Motion, Motion)> {
+    let simulation = mocap_fuse::SimulationOptions {
+        sensors: 3,
+        seed: options.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15),
+        ..Default::default()
+    };
+    let (fused, truth) = mocap_fuse::simulated_fused_take(&takes[i].motion, &simulation)
+        .map_err(|e| CleanError::Invalid(format!("{}: {e}", takes[i].path.display())))?;
+    Ok((truth, fused))
+}
+
+/// Every take of `takes` as (clean, noisy) under condition `condition` (an
+/// index into [`conditions`]).
+fn pairs(takes: &[Take], condition: usize, options: &EvalOptions) -> Result<Vec<(Motion, Motion)>> {
+    (0..takes.len())
+        .map(|i| match CONDITIONS.get(condition) {
+            Some(_) => Ok((
+                takes[i].motion.clone(),
+                make_noisy(takes, i, condition, options)?,
+            )),
+            None => fused_pair(takes, i, options),
+        })
+        .collect()
+}
 
 /// Index of the spikes-only condition in [`CONDITIONS`].
 const SPIKES_ONLY: usize = 2;
@@ -260,22 +311,16 @@ fn donor_windows(takes: &[Take], skip: usize, frames: usize, rng: &mut ChaCha8Rn
     out
 }
 
-fn tune(
-    takes: &[Take],
-    condition: usize,
-    family: &str,
-    options: &EvalOptions,
-) -> Result<TunedFilter> {
-    let noisy: Vec<Motion> = (0..takes.len())
-        .map(|i| make_noisy(takes, i, condition, options))
-        .collect::<Result<_>>()?;
+/// The settings of filter `family` with the lowest mean rotation error on
+/// `pairs` (clean, noisy) of `condition`.
+fn tune(pairs: &[(Motion, Motion)], condition: &str, family: &str) -> Result<TunedFilter> {
     let mut best: Option<(f64, Filter)> = None;
     for filter in Filter::tuning_grid(family) {
         let mut sum = 0.0;
-        for (take, n) in takes.iter().zip(&noisy) {
-            sum += rotation_error_deg(&take.motion, &filter_motion(n, &filter)?);
+        for (clean, noisy) in pairs {
+            sum += rotation_error_deg(clean, &filter_motion(noisy, &filter)?);
         }
-        let mean = sum / takes.len().max(1) as f64;
+        let mean = sum / pairs.len().max(1) as f64;
         if best.is_none_or(|(b, _)| mean < b) {
             best = Some((mean, filter));
         }
@@ -283,7 +328,7 @@ fn tune(
     let (error, filter) =
         best.ok_or_else(|| CleanError::Invalid(format!("no settings for `{family}`")))?;
     Ok(TunedFilter {
-        condition: CONDITIONS[condition].into(),
+        condition: condition.into(),
         filter,
         tuning_rotation_error_deg: error,
     })
@@ -560,11 +605,13 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 .into(),
         );
     }
-    for condition in 0..CONDITIONS.len() {
+    let names = conditions(options);
+    for (condition, name) in names.iter().enumerate() {
         let mut cleaners = Vec::new();
         if options.filters && tune_takes.len() >= 2 {
+            let tune_pairs = pairs(&tune_takes, condition, options)?;
             for family in Filter::FAMILIES {
-                let t = tune(&tune_takes, condition, family, options)?;
+                let t = tune(&tune_pairs, name, family)?;
                 cleaners.push((t.filter.label(), Cleaner::Filter(t.filter)));
                 tuned_filters.push(t);
             }
@@ -587,22 +634,28 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
         // defined on: a take too short for the acceleration is left out of
         // its mean, not made NaN of it. Only for that reason: a method that
         // outputs NaN on some take still shows as NaN (null in JSON).
-        let mut sums = vec![[0.0f64; 3]; methods.len() + 1];
-        let mut weights = vec![[0.0f64; 3]; methods.len() + 1];
+        let mut sums = vec![[0.0f64; 4]; methods.len() + 1];
+        let mut weights = vec![[0.0f64; 4]; methods.len() + 1];
         let bar = mocap_nn::train::work_bar(
             takes.len() as u64,
-            &format!("takes cleaned ({} noise)", CONDITIONS[condition]),
+            &format!("takes cleaned ({} noise)", names[condition]),
         );
         for i in 0..takes.len() {
-            let clean = &takes[i].motion;
-            let noisy = make_noisy(&takes, i, condition, options)?;
+            let fused;
+            let (clean, noisy) = if condition < CONDITIONS.len() {
+                (&takes[i].motion, make_noisy(&takes, i, condition, options)?)
+            } else {
+                fused = fused_pair(&takes, i, options)?;
+                (&fused.0, fused.1.clone())
+            };
             let w = clean.frame_count() as f64;
             let any = clean.frame_count() > 0;
-            let defined = [any, any, has_acceleration(clean)];
+            let parts = body_part_joints(clean);
+            let defined = [any, any, has_acceleration(clean), any && !parts.is_empty()];
             let mut add = |slot: usize, m: &Motion| {
-                let r = rotation_error_deg(clean, m);
+                let (r, body) = rotation_errors_deg(clean, m, &parts);
                 let (p, a) = position_errors(clean, m);
-                for (metric, value) in [r, p, a].into_iter().enumerate() {
+                for (metric, value) in [r, p, a, body].into_iter().enumerate() {
                     if defined[metric] {
                         sums[slot][metric] += value * w;
                         weights[slot][metric] += w;
@@ -614,8 +667,8 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
             bar.inc(1);
         }
         bar.finish_and_clear();
-        let names = std::iter::once("noisy input").chain(methods.iter().map(|m| m.label.as_str()));
-        for ((name, s), w) in names.zip(&sums).zip(&weights) {
+        let labels = std::iter::once("noisy input").chain(methods.iter().map(|m| m.label.as_str()));
+        for ((label, s), w) in labels.zip(&sums).zip(&weights) {
             // NaN (JSON null) only when no take defines the metric.
             let mean = |metric: usize| {
                 if w[metric] > 0.0 {
@@ -625,9 +678,10 @@ pub fn evaluate(options: &EvalOptions) -> Result<EvalReport> {
                 }
             };
             entries.push(MethodMetrics {
-                method: name.to_string(),
-                condition: CONDITIONS[condition].into(),
+                method: label.to_string(),
+                condition: names[condition].into(),
                 rotation_error_deg: mean(0),
+                body_rotation_error_deg: mean(3),
                 position_error: mean(1),
                 acceleration_error: mean(2),
             });
@@ -727,12 +781,22 @@ impl EvalReport {
             }
             s += "\n";
         }
-        for condition in CONDITIONS {
-            s += &format!("### Noise: {condition}\n\n| method | rotation error (deg) | position error (cm) | acceleration error (cm/frame^2) |\n| --- | ---: | ---: | ---: |\n");
+        let mut conditions: Vec<&str> = Vec::new();
+        for e in &self.entries {
+            if !conditions.contains(&e.condition.as_str()) {
+                conditions.push(&e.condition);
+            }
+        }
+        for condition in conditions {
+            s += &format!("### Noise: {condition}\n\n| method | rotation error (deg) | body parts alone (deg) | position error (cm) | acceleration error (cm/frame^2) |\n| --- | ---: | ---: | ---: | ---: |\n");
             for e in self.entries.iter().filter(|e| e.condition == condition) {
                 s += &format!(
-                    "| {} | {:.3} | {:.3} | {:.4} |\n",
-                    e.method, e.rotation_error_deg, e.position_error, e.acceleration_error
+                    "| {} | {:.3} | {:.3} | {:.3} | {:.4} |\n",
+                    e.method,
+                    e.rotation_error_deg,
+                    e.body_rotation_error_deg,
+                    e.position_error,
+                    e.acceleration_error
                 );
             }
             s += "\n";

@@ -260,6 +260,16 @@ impl std::str::FromStr for Filter {
 
 /// Filters the joint rotations of `motion` (see the module docs).
 pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
+    filter_joints(motion, filter, |_| true)
+}
+
+/// Filters the local rotations of the joints `chosen` says (joint indices),
+/// the others left as they are.
+pub(crate) fn filter_joints(
+    motion: &Motion,
+    filter: &Filter,
+    chosen: impl Fn(usize) -> bool,
+) -> Result<Motion> {
     let fps = motion.fps() as f32;
     filter.validate(fps)?;
     let layout = FeatureLayout::new(motion.skeleton(), Representation::Rot6d)?;
@@ -267,7 +277,7 @@ pub fn filter_motion(motion: &Motion, filter: &Filter) -> Result<Motion> {
     // A joint at a time: every channel is filtered on its own and every
     // joint's local rotations decoded on their own, so this is the take's
     // features filtered at once, without holding them.
-    for k in 0..layout.joints.len() {
+    for k in (0..layout.joints.len()).filter(|&k| chosen(layout.joints[k])) {
         let mut features = layout
             .encode_joint(motion, k)
             .expect("a layout of local 6D rotations");

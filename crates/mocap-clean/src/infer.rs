@@ -31,10 +31,11 @@ use mocap_nn::device::DeviceChoice;
 use serde::{Deserialize, Serialize};
 
 use crate::despike::{remove_spikes, DespikeOptions, FoundSpike};
-use crate::features::Representation;
+use crate::features::{FeatureLayout, Representation};
 use crate::filters::{filter_motion, filter_translations, Filter};
 use crate::metrics::rotation_error_deg;
 use crate::model_file::{window_base, with_base_input, Base, CleanModel, ModelFile};
+use crate::rig::ModelRig;
 use crate::wiener::WienerOutcome;
 use crate::{CleanError, Result};
 
@@ -76,7 +77,29 @@ impl CleanModel {
         hop: Option<usize>,
         level_deg: Option<f64>,
     ) -> Result<(Motion, Option<WienerOutcome>)> {
-        let layout = self.layout_for(motion)?;
+        // A take of another rig goes through the model's own (`crate::rig`).
+        let layout = match (self.layout_for(motion), &self.rig) {
+            (Ok(layout), _) => layout,
+            (Err(_), Some(rig)) => {
+                return rig.clean_through(motion, |played| {
+                    let layout = self.layout_for(played)?;
+                    self.clean_laid_out(played, &layout, hop, level_deg)
+                })
+            }
+            (Err(e), None) => return Err(e),
+        };
+        self.clean_laid_out(motion, &layout, hop, level_deg)
+    }
+
+    /// [`CleanModel::clean_describing`] of a take of the model's rig, whose
+    /// features are laid out by `layout`.
+    fn clean_laid_out(
+        &self,
+        motion: &Motion,
+        layout: &FeatureLayout,
+        hop: Option<usize>,
+        level_deg: Option<f64>,
+    ) -> Result<(Motion, Option<WienerOutcome>)> {
         let c = layout.channels();
         let ci = self.description.network.input_channels();
         let t = self.description.network.window;
@@ -256,22 +279,52 @@ impl ModelFile {
     /// Cleans `motion` (`hop`: see [`CleanModel::clean`]); also says what
     /// ran, e.g. `Wiener filter (sigma 4.2 deg)`.
     pub fn clean(&self, motion: &Motion, hop: Option<usize>) -> Result<(Motion, String)> {
+        let rig = self.rig_for(motion);
+        let through = rig.as_ref().map_or(String::new(), |rig| {
+            format!(", through the {} rig", rig.name())
+        });
         match self {
             ModelFile::Network(model) => {
                 let (out, outcome) = model.clean_describing(motion, hop, None)?;
                 let label = match (outcome, model.base_wiener()) {
-                    (Some(o), Some(wiener)) => format!("model ({})", wiener.describe(&o)),
-                    _ => "model".into(),
+                    (Some(o), Some(wiener)) => format!("model{through} ({})", wiener.describe(&o)),
+                    _ => format!("model{through}"),
                 };
                 Ok((out, label))
             }
             ModelFile::Wiener(filter) => {
-                let (out, outcome) = filter.clean(motion, None)?;
+                let (out, outcome) = match &rig {
+                    Some(rig) => rig.clean_through(motion, |played| filter.clean(played, None))?,
+                    None => filter.clean(motion, None)?,
+                };
                 Ok((
                     out,
-                    format!("Wiener filter ({})", filter.describe(&outcome)),
+                    format!("Wiener filter{through} ({})", filter.describe(&outcome)),
                 ))
             }
+        }
+    }
+
+    /// Whether `motion` is of another rig than the model's, which the model
+    /// cleans through its own ([`crate::rig`]).
+    pub fn cleans_through_its_rig(&self, motion: &Motion) -> bool {
+        self.rig_for(motion).is_some()
+    }
+
+    /// The model's rig, when `motion` is of another rig and the model
+    /// cleans such takes through its own.
+    fn rig_for(&self, motion: &Motion) -> Option<ModelRig> {
+        match self {
+            ModelFile::Network(model) => model
+                .layout_for(motion)
+                .is_err()
+                .then(|| model.rig.clone())
+                .flatten(),
+            ModelFile::Wiener(filter) => filter
+                .layout_for(motion)
+                .is_err()
+                .then(|| ModelRig::shipped_for(&filter.description.joints))
+                .flatten(),
         }
     }
 }
@@ -317,6 +370,10 @@ pub struct CleanReport {
     /// What the feet stage did (with `feet`).
     #[serde(default)]
     pub feet: Option<FeetReport>,
+    /// What the user should know of the result (a take of another rig than
+    /// the model's).
+    #[serde(default)]
+    pub notes: Vec<String>,
 }
 
 /// A spike that was bridged, as reported: its joint by name (the joints
@@ -363,6 +420,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
         None => (Cow::Borrowed(&original), Vec::new()),
     };
     let detect_seconds = start.elapsed().as_secs_f64();
+    let mut notes = Vec::new();
     let (cleaned, method, seconds) = match &options.method {
         Method::SpikesOnly => {
             if options.despike.is_none() {
@@ -391,6 +449,15 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                 }
             };
             let start = Instant::now();
+            if model.cleans_through_its_rig(&motion) {
+                notes.push(format!(
+                    "{} is not of the model's rig: it was cleaned through the model's rig \
+                     (its body parts played there, the change carried back); on real takes of \
+                     other rigs the model measured worse than `--filter butterworth-gcv:2` \
+                     (bench/results/clean.md, \"Other rigs\"): compare the two",
+                    options.input.display()
+                ));
+            }
             let (out, label) = model.clean(&motion, options.hop).map_err(in_file)?;
             (
                 out,
@@ -429,6 +496,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
             .map(|s| BridgedSpike::new(&original, s))
             .collect(),
         feet,
+        notes,
     })
 }
 

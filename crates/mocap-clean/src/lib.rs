@@ -104,6 +104,7 @@ mod model;
 mod model_file;
 mod noise;
 mod recipe;
+mod rig;
 mod training;
 mod wiener;
 mod wiener_fit;

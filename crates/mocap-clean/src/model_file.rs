@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::features::{FeatureLayout, Recentering, Representation, RotationFrame};
 use crate::filters::{filter_features, Filter};
 use crate::model::{Denoiser, DenoiserConfig};
+use crate::rig::ModelRig;
 use crate::wiener::{LevelEstimate, WienerDescription, WienerFilter, WienerOutcome, WIENER_KIND};
 use crate::{CleanError, Result};
 
@@ -212,6 +213,9 @@ pub struct CleanModel {
     /// The learned filter the network corrects
     /// ([`ModelDescription::base_wiener`]).
     pub(crate) base_wiener: Option<WienerFilter>,
+    /// The rig the model was trained on, when it is the shipped one: takes
+    /// of other rigs are cleaned through it ([`crate::rig`]).
+    pub(crate) rig: Option<ModelRig>,
 }
 
 impl std::fmt::Debug for CleanModel {
@@ -303,6 +307,7 @@ impl CleanModel {
             _ => None,
         };
         Ok(CleanModel {
+            rig: ModelRig::shipped_for(&description.joints),
             description,
             source: origin.to_path_buf(),
             model,
@@ -321,9 +326,7 @@ impl CleanModel {
             return Err(CleanError::Invalid(format!(
                 "the model was trained on a rig of {} joints with rotations ({}, ...), this take \
                  has {} ({c} features against {}): clean it with --filter butterworth-gcv:2, or \
-                 train a model on this rig with `mocap clean train` (played by the model's rig \
-                 through retargeting, takes of other rigs came out worse than with that filter: \
-                 bench/results/clean.md, \"Known limits\")",
+                 train a model on this rig with `mocap clean train`",
                 self.description.joints.len(),
                 self.description.joints[..self.description.joints.len().min(3)].join(", "),
                 layout.joints.len(),
@@ -444,11 +447,22 @@ impl ModelFile {
     }
 
     /// `Ok` when this model can clean `motion` (it was trained or fitted on
-    /// `motion`'s rig), else the error [`ModelFile::clean`] would give.
+    /// `motion`'s rig, or cleans other rigs through its own and finds
+    /// `motion`'s body parts), else the error [`ModelFile::clean`] would
+    /// give.
     pub fn check_rig(&self, motion: &Motion) -> Result<()> {
         match self {
-            ModelFile::Network(model) => model.layout_for(motion).map(|_| ()),
-            ModelFile::Wiener(filter) => filter.layout_for(motion).map(|_| ()),
+            ModelFile::Network(model) => match (model.layout_for(motion), &model.rig) {
+                (Err(_), Some(rig)) => rig.check(motion),
+                (result, _) => result.map(|_| ()),
+            },
+            ModelFile::Wiener(filter) => match (
+                filter.layout_for(motion),
+                ModelRig::shipped_for(&filter.description.joints),
+            ) {
+                (Err(_), Some(rig)) => rig.check(motion),
+                (result, _) => result.map(|_| ()),
+            },
         }
     }
 }

@@ -58,8 +58,10 @@
 //! Root translation is never changed.
 
 use mocap_core::forward_kinematics;
+use mocap_core::retarget::Retargeting;
 use mocap_core::rotation::{expmap_to_quat, Quat, Vec3};
 use mocap_core::Motion;
+use mocap_core::Skeleton;
 use rand::{Rng, RngExt};
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
@@ -485,5 +487,61 @@ mod tests {
                 assert!(angle < 1e-3, "frame {f} joint {j} inside {inside}");
             }
         }
+    }
+}
+
+/// Noise as other rigs make it, for a model that cleans their takes through
+/// its own rig (`crate::rig`): a take of another rig has its noise on that
+/// rig's joints, about that rig's bones (the chain correction makes most of
+/// a joint's error a turn about its bone), and the model sees it played by
+/// its own rig. Each sample is played by one of the rigs or by its own, at
+/// random; the noise is put on there and both the clean and the noisy
+/// sample are played back, so that the model learns to give the clean one
+/// as its rig plays it.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct NoiseRigs {
+    /// Each rig: from the model's rig to it, and back.
+    rigs: Vec<(Retargeting, Retargeting)>,
+}
+
+impl NoiseRigs {
+    /// The retargetings between `own` (the model's rig) and each of
+    /// `others`, whose body parts must be found.
+    pub(crate) fn new(own: &Skeleton, others: &[Skeleton]) -> Result<NoiseRigs> {
+        let rigs = others
+            .iter()
+            .map(|other| {
+                Ok((
+                    Retargeting::detect(own, other)?,
+                    Retargeting::detect(other, own)?,
+                ))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(NoiseRigs { rigs })
+    }
+
+    /// `clean` (of the model's rig) and a noisy copy as [`add_noise`] makes
+    /// it, both through a rig drawn at random (one of the others, or none:
+    /// then `clean` itself): (clean, noisy).
+    pub(crate) fn add_noise<R: Rng + ?Sized>(
+        &self,
+        clean: &Motion,
+        donors: &[&Motion],
+        config: &NoiseConfig,
+        rng: &mut R,
+    ) -> Result<(Motion, Motion)> {
+        let k = rng.random_range(0..=self.rigs.len());
+        let Some((there, back)) = k.checked_sub(1).map(|k| &self.rigs[k]) else {
+            let noisy = add_noise(clean, donors, config, rng)?;
+            return Ok((clean.clone(), noisy));
+        };
+        let played = there.apply(clean)?;
+        let donors = donors
+            .iter()
+            .map(|d| there.apply(d))
+            .collect::<mocap_core::Result<Vec<_>>>()?;
+        let donor_refs: Vec<&Motion> = donors.iter().collect();
+        let noisy = add_noise(&played, &donor_refs, config, rng)?;
+        Ok((back.apply(&played)?, back.apply(&noisy)?))
     }
 }

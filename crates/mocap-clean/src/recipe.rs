@@ -1,5 +1,6 @@
 //! A training recipe: the rarely changed knobs of [`TrainOptions`] (the
-//! network's shape, the synthetic noise's spike settings) in a TOML file
+//! network's shape, the synthetic noise's spike settings, the other rigs
+//! the noise is put on) in a TOML file
 //! (`mocap clean train --recipe FILE.toml`). Every key is optional; a key
 //! not given keeps the default, and a key the recipe does not know is
 //! refused, naming the file and the key.
@@ -10,7 +11,7 @@
 //! window = 32
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +40,9 @@ pub struct TrainRecipe {
     pub max_spikes: Option<usize>,
     /// Standard deviation of a spike's duration in frames.
     pub spike_sigma: Option<f32>,
+    /// Motion files whose rigs the noise is also put on
+    /// ([`TrainOptions::noise_rigs`]), relative to the recipe's folder.
+    pub noise_rigs: Option<Vec<PathBuf>>,
 }
 
 impl TrainRecipe {
@@ -46,7 +50,13 @@ impl TrainRecipe {
     /// recipe does not know, the key).
     pub fn load(path: &Path) -> Result<TrainRecipe> {
         let text = std::fs::read_to_string(path).map_err(|e| mocap_core::Error::io(path, e))?;
-        Self::parse(&text).map_err(|e| CleanError::Invalid(format!("{}: {e}", path.display())))
+        let mut recipe = Self::parse(&text)
+            .map_err(|e| CleanError::Invalid(format!("{}: {e}", path.display())))?;
+        let folder = path.parent().unwrap_or(Path::new(""));
+        for rig in recipe.noise_rigs.iter_mut().flatten() {
+            *rig = folder.join(&*rig);
+        }
+        Ok(recipe)
     }
 
     /// Parses a recipe's TOML text.
@@ -69,6 +79,7 @@ impl TrainRecipe {
             set(&mut spikes.max_spikes, self.max_spikes);
             set(&mut spikes.duration_sigma_frames, self.spike_sigma);
         }
+        set(&mut options.noise_rigs, self.noise_rigs.clone());
     }
 }
 

@@ -10,13 +10,16 @@
 //! The validation loss is the plain mean squared error of the features, for
 //! every training loss, so that curves of different losses compare.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
+use mocap_core::io::read_motion;
 use mocap_core::Motion;
-use mocap_nn::checkpoint::{save_epoch, start_run, CheckpointHeader, RunStart};
+use mocap_nn::checkpoint::{
+    load_weights_from_bytes, save_epoch, start_run, CheckpointHeader, RunStart,
+};
 use mocap_nn::device::{seed_device, DeviceChoice};
 use mocap_nn::plot::PlotOptions;
 use mocap_nn::train::{epoch_seed, optimizer_step, run_epochs, EpochPlan, History};
@@ -34,10 +37,10 @@ use crate::fk::FkSkeleton;
 use crate::loss::{derivative_loss, position_loss, LossWeights};
 use crate::model::{Denoiser, DenoiserConfig};
 use crate::model_file::{
-    base_input_channels, window_base, with_base_input, Base, ModelDescription, CHECKPOINT_KIND,
-    CHECKPOINT_KIND_VERSION,
+    base_input_channels, window_base, with_base_input, Base, CleanModel, ModelDescription,
+    CHECKPOINT_KIND, CHECKPOINT_KIND_VERSION,
 };
-use crate::noise::{add_noise, NoiseConfig};
+use crate::noise::{NoiseConfig, NoiseRigs};
 use crate::wiener::WienerFilter;
 use crate::{CleanError, Result};
 
@@ -109,6 +112,18 @@ pub struct TrainOptions {
     pub plot: Option<PathBuf>,
     /// Use at most this many training takes (quick runs and tests).
     pub max_train_takes: Option<usize>,
+    /// Start from the weights of this model file (the same network on the
+    /// same rig, e.g. the shipped model, to go on training it on other
+    /// noise) instead of random weights. A resumed run ignores it.
+    #[serde(default)]
+    pub init: Option<PathBuf>,
+    /// Other rigs (motion files whose skeletons are used) the noise is also
+    /// put on: each window is played by one of them or by its own rig at
+    /// random, the noise put on there, and the clean and the noisy window
+    /// played back. What a model that cleans takes of other rigs through
+    /// its own rig (`crate::rig`) sees: their noise is about their bones.
+    #[serde(default)]
+    pub noise_rigs: Vec<PathBuf>,
     /// Weight of the position term of the loss (forward kinematics of the
     /// 6D features on the first training take's skeleton, see `fk.rs`), per
     /// squared skeleton unit; 0 leaves it out (the report's loss).
@@ -146,6 +161,8 @@ impl Default for TrainOptions {
             device: DeviceChoice::Cpu,
             plot: None,
             max_train_takes: None,
+            init: None,
+            noise_rigs: Vec::new(),
             position_weight: 0.0,
         }
     }
@@ -189,6 +206,8 @@ pub struct WindowSampler<'a> {
     /// The input also holds the base's output and noise level
     /// ([`TrainOptions::base_input`]).
     base_input: bool,
+    /// Other rigs the noise is put on ([`TrainOptions::noise_rigs`]).
+    rigs: NoiseRigs,
 }
 
 impl<'a> WindowSampler<'a> {
@@ -224,7 +243,15 @@ impl<'a> WindowSampler<'a> {
             base: None,
             context: 0,
             base_input: false,
+            rigs: NoiseRigs::default(),
         })
+    }
+
+    /// Samples whose noise is also put on other rigs
+    /// ([`TrainOptions::noise_rigs`]).
+    pub(crate) fn with_noise_rigs(mut self, rigs: NoiseRigs) -> Self {
+        self.rigs = rigs;
+        self
     }
 
     /// Targets for a model whose output is added to `base` run on its
@@ -283,7 +310,7 @@ impl<'a> WindowSampler<'a> {
             donors.push(looped_window(&self.takes[d].motion, s, end - first));
         }
         let donor_refs: Vec<&Motion> = donors.iter().collect();
-        let noisy = add_noise(&clean, &donor_refs, &self.noise, rng)?;
+        let (clean, noisy) = self.rigs.add_noise(&clean, &donor_refs, &self.noise, rng)?;
         Ok(Stretch {
             noisy,
             clean,
@@ -387,6 +414,41 @@ fn validation_loss(
         sum += loss as f64;
     }
     sum / batches.len().max(1) as f64
+}
+
+/// The network training starts from: random weights, or those of the model
+/// file `init` (which must have the same network, rig and base).
+fn initial_network(
+    network: &DenoiserConfig,
+    description: &ModelDescription,
+    init: Option<&Path>,
+    device: &Device,
+) -> Result<Denoiser> {
+    let fresh = network.init(device)?;
+    let Some(path) = init else {
+        return Ok(fresh);
+    };
+    let model = CleanModel::load(path, Default::default())?;
+    let given = &model.description;
+    if given.network != *network
+        || given.joints != description.joints
+        || given.representation != description.representation
+        || given.frame != description.frame
+        || given.base_input() != description.base_input()
+    {
+        return Err(CleanError::Invalid(format!(
+            "{}: its network, rig or inputs are not those of this training (train with its \
+             recipe, rig and base options)",
+            path.display()
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| mocap_core::Error::io(path, e))?;
+    let mut fresh = fresh;
+    // The weights ride with the base filter the file also holds.
+    fresh.base = given.base_wiener.as_ref().map(WienerFilter::empty_tensors);
+    let mut loaded = load_weights_from_bytes(bytes, path, fresh)?;
+    loaded.base = None;
+    Ok(loaded)
 }
 
 /// Trains a denoiser (see the module docs).
@@ -504,12 +566,20 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
     } else {
         None
     };
+    let others = options
+        .noise_rigs
+        .iter()
+        .map(|path| Ok(read_motion(path)?.skeleton().clone()))
+        .collect::<Result<Vec<_>>>()?;
+    let rigs = NoiseRigs::new(first.motion.skeleton(), &others)?;
     let train_sampler = WindowSampler::new(&train_takes, &layout, network.window, options.noise)?
         .with_base(base, options.base_context)
-        .with_base_input(options.base_input);
+        .with_base_input(options.base_input)
+        .with_noise_rigs(rigs.clone());
     let valid_sampler = WindowSampler::new(&valid_takes, &layout, network.window, options.noise)?
         .with_base(base, options.base_context)
-        .with_base_input(options.base_input);
+        .with_base_input(options.base_input)
+        .with_noise_rigs(rigs);
     let shape = [options.batch_size, network.input_channels(), network.window];
     let target_shape = [
         options.batch_size,
@@ -555,7 +625,7 @@ pub fn train(options: &TrainOptions) -> Result<TrainReport> {
         options.state_dir.as_deref(),
         options.plot.as_deref(),
         options.resume,
-        network.init(&device)?,
+        initial_network(&network, &description, options.init.as_deref(), &device)?,
     )?;
     let resumed_from_epoch = history.epochs.len();
     let header = |history: &History| CheckpointHeader {
@@ -727,6 +797,49 @@ mod tests {
             },
             ..TrainOptions::default()
         }
+    }
+
+    #[test]
+    fn a_run_started_from_a_model_starts_where_that_model_ended() {
+        let _one = ONE_RUN_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+        let dir = tempfile::tempdir().unwrap();
+        let base = tiny_setup(dir.path());
+        let first = TrainOptions {
+            out: dir.path().join("a.safetensors"),
+            epochs: 1,
+            ..base.clone()
+        };
+        let a = train(&first).unwrap();
+        // Not one step taken (a zero learning rate): the weights, and so
+        // the validation loss, are the first model's; from random weights
+        // they are not.
+        let still = |init: Option<PathBuf>, out: &str| TrainOptions {
+            out: dir.path().join(out),
+            epochs: 1,
+            learning_rate: 0.0,
+            init,
+            ..base.clone()
+        };
+        let b = train(&still(Some(a.model.clone()), "b.safetensors")).unwrap();
+        let fresh = train(&still(None, "c.safetensors")).unwrap();
+        let loss = |r: &TrainReport| r.history.epochs[0].valid_loss;
+        assert!(
+            (loss(&a) - loss(&b)).abs() < 1e-6 * loss(&a),
+            "{} {}",
+            loss(&a),
+            loss(&b)
+        );
+        assert!((loss(&a) - loss(&fresh)).abs() > 1e-3 * loss(&a));
+        // Another network: refused, naming the file.
+        let wider = TrainOptions {
+            network: DenoiserConfig {
+                width: 8,
+                ..base.network
+            },
+            ..still(Some(a.model.clone()), "d.safetensors")
+        };
+        let error = train(&wider).unwrap_err().to_string();
+        assert!(error.contains("a.safetensors"), "{error}");
     }
 
     #[test]

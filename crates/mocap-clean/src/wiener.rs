@@ -794,6 +794,38 @@ impl WienerFilter {
         })
     }
 
+    /// The single filter a mixture was made from (its `all` component,
+    /// which [`fit_mixture`] adds), or this filter when it is one.
+    pub(crate) fn single(&self) -> Result<WienerFilter> {
+        if self.components.len() == 1 {
+            return Ok(self.clone());
+        }
+        let k = self
+            .description
+            .components
+            .iter()
+            .position(|c| c.name == "all")
+            .ok_or_else(|| {
+                CleanError::Invalid(
+                    "this mixture has no `all` component, the single filter it was made from"
+                        .into(),
+                )
+            })?;
+        let info = &self.description.components[k];
+        Ok(WienerFilter {
+            description: WienerDescription {
+                takes: info.takes,
+                segments: info.segments,
+                components: Vec::new(),
+                ..self.description.clone()
+            },
+            components: vec![self.components[k].clone()],
+            noise: self.noise.clone(),
+            whitening: self.whitening.clone(),
+            level_estimate: self.level_estimate,
+        })
+    }
+
     /// Whether `other` reads takes as this filter does: the same rig,
     /// segment and noise covariance `N` at the same level, so that their
     /// levels mean the same and their likelihoods (2) compare.
@@ -1539,6 +1571,8 @@ pub fn fit_mixture(
     takes: &[Take],
     min_segments: usize,
 ) -> Result<WienerFilter> {
+    // A mixture is refitted from the single filter it was made from.
+    let single = &single.single()?;
     let segment = single.description.segment;
     let mut groups: std::collections::BTreeMap<&str, Vec<&Motion>> = Default::default();
     for take in takes {

@@ -737,18 +737,62 @@ fn unusable_inputs_are_refused_naming_the_file() {
         "at least 2",
     );
 
-    // A take of another rig than the shipped denoiser's.
-    let Some(other_rig) = mocap_testdata::shared("parser-cases/bvhanim_test_mocapbank.bvh") else {
-        return;
-    };
+    // A take of another rig than the shipped denoiser's, whose body parts
+    // are not found: refused, naming the take, what is missing and --rig.
+    let other_rig = dir.path().join("two-joints.bvh");
+    std::fs::write(&other_rig, TWO_JOINTS_BVH).unwrap();
     let out = mocap(&["clean", "apply", path(&other_rig), "-o", path(&output)]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("bvhanim_test_mocapbank.bvh") && stderr(&out).contains("--filter"),
-        "{}",
-        stderr(&out)
-    );
+    let says = stderr(&out);
+    for part in ["two-joints.bvh", "Bandai Namco", "--rig"] {
+        assert!(says.contains(part), "no {part:?} in: {says}");
+    }
     assert!(!output.exists());
+}
+
+/// A take of a rig of two joints (a hip and a knee): no body map finds it.
+const TWO_JOINTS_BVH: &str = "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition \
+    Yposition Zposition Zrotation Xrotation Yrotation\n  JOINT Knee\n  {\n    OFFSET 0 -40 0\n    \
+    CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -40 0\n    }\n  \
+    }\n}\nMOTION\nFrames: 3\nFrame Time: 0.0333333\n0 90 0 0 0 0 10 0 0\n0 90 0 0 0 0 12 0 0\n\
+    0 90 0 0 0 0 14 0 0\n";
+
+#[test]
+fn clean_apply_cleans_a_take_of_another_rig_through_the_models_rig() {
+    let Some(take) =
+        mocap_testdata::shared("parser-cases/dme_example_crlf_leadingdot_frametime.bvh")
+    else {
+        eprintln!("../shared/data is absent: skipped");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("cleaned.bvh");
+    let out = mocap(&["clean", "apply", path(&take), "-o", path(&output), "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let method = report["method"].as_str().unwrap();
+    assert!(method.contains("through the Bandai Namco rig"), "{method}");
+    // The take's own skeleton and channels; the thumbs (no body part)
+    // untouched;
+    // the body cleaned.
+    let (before, after) = (read_bvh(&take).unwrap(), read_bvh(&output).unwrap());
+    assert_eq!(before.skeleton(), after.skeleton());
+    assert_eq!(before.frame_count(), after.frame_count());
+    let skeleton = before.skeleton();
+    for name in ["LThumb", "RThumb"] {
+        let j = skeleton.find(name).unwrap();
+        for f in 0..before.frame_count() {
+            assert_eq!(
+                before.joint_values(f, j),
+                after.joint_values(f, j),
+                "{name}"
+            );
+        }
+    }
+    let knee = skeleton.find("LeftLeg").unwrap();
+    let moved = (0..before.frame_count())
+        .any(|f| before.joint_values(f, knee) != after.joint_values(f, knee));
+    assert!(moved, "the knee was not cleaned");
 }
 
 /// The bundled walk's header announcing `frames` frames, and no frame
@@ -883,7 +927,7 @@ fn style_clips_and_sources_of_other_rigs_are_retargeted() {
 }
 
 #[test]
-fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
+fn a_rig_file_given_with_rig_lets_info_search_clean_and_style_read_a_renamed_rig() {
     // The bundled walk with every joint renamed: no built-in rig table
     // knows the names, a rig file says which joint is which.
     let dir = tempfile::tempdir().unwrap();
@@ -955,9 +999,8 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
         }
     }
 
-    // The denoiser reads joints in its own rig's places: same count, other
-    // names is refused, and the take played by the model's rig first is
-    // cleaned as the original is.
+    // The denoiser reads joints in its own rig's places: the renamed rig is
+    // cleaned through the model's own, as the original is.
     let cleaned_renamed = dir.path().join("cleaned-renamed.bvh");
     let out = mocap(&[
         "--rig",
@@ -968,31 +1011,11 @@ fn a_rig_file_given_with_rig_lets_info_search_and_style_read_a_renamed_rig() {
         "-o",
         path(&cleaned_renamed),
     ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("\"Wurzel\" where the model has \"joint_Root\""),
-        "{}",
-        stderr(&out)
-    );
-    let on_bandai = dir.path().join("on-bandai.bvh");
-    let out = mocap(&[
-        "--rig",
-        rig,
-        "convert",
-        renamed,
-        path(&on_bandai),
-        "--retarget-to",
-        &walk,
-    ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("through the Bandai Namco rig"));
     let cleaned = dir.path().join("cleaned.bvh");
-    for (input, output) in [
-        (path(&on_bandai), &cleaned_renamed),
-        (walk.as_str(), &cleaned),
-    ] {
-        let out = mocap(&["clean", "apply", input, "-o", path(output)]);
-        assert!(out.status.success(), "{}", stderr(&out));
-    }
+    let out = mocap(&["clean", "apply", &walk, "-o", path(&cleaned)]);
+    assert!(out.status.success(), "{}", stderr(&out));
     assert!(rotation_change_deg(&cleaned, &cleaned_renamed) < 1e-3);
 
     // A rig file with a mistake stops the command before it starts.
@@ -1077,19 +1100,12 @@ fn clean_eval_names_a_take_the_model_cannot_clean_and_skips_short_takes_in_accel
     let notes = report["notes"].to_string();
     assert!(notes.contains("under 3 frames (short)"), "{notes}");
 
-    // A take of another rig, with the shipped model asked for: refused
-    // before any work, naming the take and the way out.
+    // A take of a rig whose body parts are not found, with the shipped
+    // model asked for: refused before any work, naming the take and the
+    // way out.
     std::fs::remove_file(&short).unwrap();
     let other = dir.path().join("other-rig.bvh");
-    std::fs::write(
-        &other,
-        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition \
-         Zrotation Xrotation Yrotation\n  JOINT Knee\n  {\n    OFFSET 0 -40 0\n    CHANNELS 3 \
-         Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -40 0\n    }\n  }\n}\n\
-         MOTION\nFrames: 3\nFrame Time: 0.0333333\n0 90 0 0 0 0 10 0 0\n0 90 0 0 0 0 12 0 0\n\
-         0 90 0 0 0 0 14 0 0\n",
-    )
-    .unwrap();
+    std::fs::write(&other, TWO_JOINTS_BVH).unwrap();
     let out = mocap(&["clean", "eval", path(dir.path()), "--all-takes"]);
     assert!(!out.status.success());
     let err = stderr(&out);
@@ -1351,4 +1367,26 @@ fn a_damaged_model_file_is_refused_before_anything_is_written() {
         "{message}"
     );
     assert!(!dir.path().join("clean.bvh").exists());
+}
+
+#[test]
+fn clean_eval_fused_measures_takes_as_the_capture_stage_makes_them() {
+    // The bundled walks watched by simulated sensors, fused and fitted: the
+    // filters are tuned on that noise and measured against the truth on the
+    // fused take's skeleton.
+    let samples = mocap_testdata::repo_root().join("samples");
+    let out = clean_eval_filters(&samples, &["--all-takes", "--fused", "--json"]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let fused: Vec<&serde_json::Value> = report["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["condition"] == "fused")
+        .collect();
+    assert!(fused.len() > 2, "{fused:?}");
+    let noisy = fused.iter().find(|e| e["method"] == "noisy input").unwrap();
+    let cm = noisy["position_error"].as_f64().unwrap();
+    assert!(cm > 0.5 && cm < 10.0, "{noisy}");
+    let tuned = report["tuned_filters"].as_array().unwrap();
+    assert!(tuned.iter().any(|t| t["condition"] == "fused"), "{tuned:?}");
 }

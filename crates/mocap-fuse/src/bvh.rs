@@ -486,6 +486,18 @@ pub fn poses_to_motion_with(
     lengths: BoneLengthSource,
 ) -> Result<Motion> {
     let fitted = fit_skeleton(poses, body, lengths, options.units_per_metre)?;
+    poses_on_skeleton(poses, &fitted, options)
+}
+
+/// Joint positions (metres, Kinect order, one array per frame at
+/// `options.fps`) as a BVH motion on a skeleton already fitted (to these
+/// poses or to others of the same person: a fused take and its truth on one
+/// skeleton).
+pub fn poses_on_skeleton(
+    poses: &[[Vec3; JOINT_COUNT]],
+    fitted: &FittedSkeleton,
+    options: &BvhOptions,
+) -> Result<Motion> {
     let mut motion = Motion::rest(fitted.skeleton.clone(), 1.0 / options.fps, poses.len())?;
     let mut bend = [None; JOINT_COUNT];
     let mut previous: Option<[Quat; JOINT_COUNT]> = None;

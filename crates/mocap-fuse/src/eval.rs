@@ -18,11 +18,13 @@
 
 use std::path::{Path, PathBuf};
 
+use mocap_core::ops::trim;
 use mocap_core::rotation::Vec3;
-use mocap_core::{Error, Result};
+use mocap_core::{Error, Motion, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::body::{BodyModel, MeasureOptions};
+use crate::bvh::{fit_skeleton, poses_on_skeleton, regular_poses, BoneLengthSource, BvhOptions};
 use crate::calib::Calibration;
 use crate::confidence::BoneLengthFunction;
 use crate::fusion::{Fuser, FusionOptions, OneEuroParams};
@@ -30,6 +32,53 @@ use crate::kinect::GroundTruth;
 use crate::kinect::{joint::*, JOINT_COUNT};
 use crate::offline::{fuse_streams, views_at, SensorStreams};
 use crate::sim::{simulate_capture, SimulatedCapture, SimulationOptions};
+
+/// A take as the capture stage makes it: `motion` watched by the simulated
+/// sensors of `options` (the person measured from a second capture), fused
+/// offline by the best fusion ([`FusionOptions::best`]) and fitted as a BVH
+/// as `mocap fuse run` does (bone lengths from the fused take), with the
+/// truth it watched on the same skeleton (cm): `(fused, truth)`, frame for
+/// frame from the first fused instant. What a denoiser of fused captures is
+/// measured on (`mocap clean eval --fused`).
+pub fn simulated_fused_take(
+    motion: &Motion,
+    options: &SimulationOptions,
+) -> Result<(Motion, Motion)> {
+    let SimulatedCapture {
+        simulation: sim,
+        body,
+        ..
+    } = simulate_capture(motion, None, options)?;
+    let truth = &sim.truth;
+    let streams = SensorStreams::new(sim.sensors.iter().flat_map(|s| s.frames.iter().cloned()));
+    let mut fuser = Fuser::new(FusionOptions::best(), body.clone());
+    let fused: Vec<_> = fuse_streams(
+        &streams,
+        &sim.calibration(),
+        &mut fuser,
+        truth.fps,
+        Some(0.0),
+    )
+    .into_iter()
+    .filter(|f| f.time <= truth.duration())
+    .collect();
+    let first = fused
+        .first()
+        .ok_or_else(|| Error::Invalid("the simulated sensors saw nothing to fuse".into()))?;
+    // The fused motion starts at the first fused instant, a frame of the
+    // truth's grid (instants are multiples of the period).
+    let skip = ((first.time * truth.fps).round() as usize).min(truth.frames.len());
+    let bvh = BvhOptions {
+        units_per_metre: 100.0,
+        fps: truth.fps,
+    };
+    let poses = regular_poses(&fused, truth.fps);
+    let fitted = fit_skeleton(&poses, &body, BoneLengthSource::Fused, bvh.units_per_metre)?;
+    let fused = poses_on_skeleton(&poses, &fitted, &bvh)?;
+    let truth = poses_on_skeleton(&truth.frames[skip..], &fitted, &bvh)?;
+    let n = fused.frame_count().min(truth.frame_count());
+    Ok((trim(&fused, 0..n)?, trim(&truth, 0..n)?))
+}
 
 /// How the sensors' poses are known in the evaluation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -123,16 +123,17 @@ pub use body::{
     BodyModel, MeasureOptions, ANGLES,
 };
 pub use bvh::{
-    fit_error, fit_skeleton, fused_to_motion, fused_to_motion_with, poses_to_motion,
-    poses_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError, FittedSkeleton,
+    fit_error, fit_skeleton, fused_to_motion, fused_to_motion_with, poses_on_skeleton,
+    poses_to_motion, poses_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError,
+    FittedSkeleton,
 };
 pub use calib::{Calibration, RigidTransform, SensorPose};
 pub use confidence::{BoneLengthFunction, ConfidenceModel, RangeOfMotionTerm, StateWeights};
 pub use eval::{
     consistency_markdown, evaluate, evaluate_consistency, evaluate_inputs, evaluate_recordings,
-    evaluate_with, group_takes, report_markdown, CalibrationError, CalibrationSource,
-    ConsistencyReport, ConsistencyRow, EvalOptions, EvalReport, Evaluation, MethodResult,
-    PerJointChart, PerJointSeries, CONSISTENCY_BONES,
+    evaluate_with, group_takes, report_markdown, simulated_fused_take, CalibrationError,
+    CalibrationSource, ConsistencyReport, ConsistencyRow, EvalOptions, EvalReport, Evaluation,
+    MethodResult, PerJointChart, PerJointSeries, CONSISTENCY_BONES,
 };
 pub use fusion::{
     facing_of, FusedFrame, Fuser, FusionOptions, OneEuroParams, SensorView, METHOD_NAMES,

@@ -104,3 +104,35 @@ fn fusion_and_body_calibration_on_a_real_take() {
     eprintln!("fused MPJPE: true calibration {best:.4} m, body calibration {with_body:.4} m");
     assert!(with_body < best + 0.03, "{with_body} vs {best}");
 }
+
+#[test]
+fn a_take_as_the_capture_stage_makes_it_pairs_with_its_truth_frame_for_frame() {
+    // The bundled walk: the fused take and its truth share one fitted
+    // skeleton and their frames, and lie a few centimetres apart.
+    let motion = mocap_core::io::bvh::read_bvh(&mocap_testdata::sample_walk()).unwrap();
+    let options = SimulationOptions {
+        sensors: 3,
+        seed: 2,
+        ..Default::default()
+    };
+    let (fused, truth) = mocap_fuse::simulated_fused_take(&motion, &options).unwrap();
+    assert_eq!(fused.skeleton(), truth.skeleton());
+    assert_eq!(fused.frame_count(), truth.frame_count());
+    assert!(fused.frame_count() + 2 >= motion.frame_count());
+    let (a, b) = (
+        mocap_core::forward_kinematics(&fused),
+        mocap_core::forward_kinematics(&truth),
+    );
+    let cm = mocap_core::metrics::mean_joint_position_error(&a, &b, None).unwrap();
+    assert!(cm > 0.5 && cm < 10.0, "{cm} cm");
+    // Shifted by one frame, the pair is further apart: the frames match.
+    let shifted = mocap_core::ops::trim(&truth, 1..truth.frame_count()).unwrap();
+    let ahead = mocap_core::ops::trim(&fused, 0..fused.frame_count() - 1).unwrap();
+    let off = mocap_core::metrics::mean_joint_position_error(
+        &mocap_core::forward_kinematics(&ahead),
+        &mocap_core::forward_kinematics(&shifted),
+        None,
+    )
+    .unwrap();
+    assert!(off > cm, "{off} against {cm}");
+}

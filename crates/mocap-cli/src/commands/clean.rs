@@ -98,9 +98,9 @@ struct CleanTrainArgs {
     train_loop: TrainLoopArgs,
     #[command(flatten)]
     device: DeviceArgs,
-    /// The network's shape and the synthetic spikes' settings as TOML (keys: large, width, levels,
-    /// blocks, window, spike_probability, max_spikes, spike_sigma; each optional). The shipped
-    /// network's: models/clean-recipe.toml.
+    /// The network's shape and the synthetic noise's settings as TOML (keys: large, width, levels,
+    /// blocks, window, spike_probability, max_spikes, spike_sigma, noise_rigs; each optional). The
+    /// shipped network's: models/clean-recipe.toml.
     #[arg(long, value_name = "FILE.toml")]
     recipe: Option<PathBuf>,
     /// `derivative` (rotation + velocity + acceleration terms, alpha = dt^2, beta = dt^4) or `mse`.
@@ -141,9 +141,10 @@ struct CleanTrainArgs {
     /// `joint_Root` on the floor; off by default, see bench/results/clean.md).
     #[arg(long)]
     noise_above_pelvis: bool,
-    /// Train on at most this many takes (quick runs).
-    #[arg(long)]
-    max_train_takes: Option<usize>,
+    /// Start from this model's weights (the same recipe, rig and base options; e.g.
+    /// models/clean-default.safetensors, to train the shipped network on more noise) instead of random ones.
+    #[arg(long, value_name = "FILE")]
+    init: Option<PathBuf>,
     /// Folder of the resumable training state (default: OUTPUT.state).
     #[arg(long)]
     state: Option<PathBuf>,
@@ -208,6 +209,10 @@ struct CleanEvalArgs {
     /// validation takes).
     #[arg(long)]
     despike: bool,
+    /// Also the noise of the capture stage: each take watched by three simulated Kinect sensors,
+    /// fused and fitted as a BVH, against its truth on the same fitted skeleton (condition `fused`).
+    #[arg(long)]
+    fused: bool,
     /// Evaluate every take, not only the test split (for data the models were not trained on);
     /// the filters and spike finding are then tuned on the first --tune-takes of those same takes,
     /// which flatters them (the report says so).
@@ -295,6 +300,9 @@ fn run_apply(a: CleanApplyArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             eprintln!("bridged {} spikes {when}", report.spikes.len());
             list_spikes(&report.spikes);
         }
+        for note in &report.notes {
+            eprintln!("note: {note}");
+        }
         if let Some(feet) = &report.feet {
             eprintln!("{}", super::feet::summary(feet));
         }
@@ -333,7 +341,7 @@ fn run_train(a: CleanTrainArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         plot: l.plot,
         device: a.device.device,
         seed: l.seed,
-        max_train_takes: a.max_train_takes,
+        init: a.init,
         derivative_loss: a.loss == "derivative",
         base_filter: a.base_filter,
         base_wiener: a.base_wiener,
@@ -436,6 +444,7 @@ fn run_eval(a: CleanEvalArgs) -> anyhow::Result<()> {
         max_takes: a.max_takes,
         device: a.device.device,
         despike: a.despike,
+        fused: a.fused,
         ..EvalOptions::default()
     };
     o.random.perturb_above_pelvis = a.noise_above_pelvis;
