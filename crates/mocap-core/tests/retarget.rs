@@ -192,23 +192,37 @@ fn real_takes_played_by_cmu_and_mixamo_rigs_keep_their_bones_and_come_back() {
     }
 }
 
-#[test]
-fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
+/// The CMU-style and the Mixamo take of the parser cases (their first
+/// `frames` frames), each with that take played by the Bandai rig and the
+/// retargeting back; none without ../shared/data.
+fn parser_cases_on_bandai(frames: usize) -> Vec<(&'static str, Motion, Motion, Retargeting)> {
     let Some(data) = shared_data() else {
         eprintln!("../shared/data is absent: skipped");
-        return;
+        return Vec::new();
     };
     let bandai = read_bvh(&sample_walk()).unwrap();
-    for rig in [
+    [
         "dme_example_crlf_leadingdot_frametime.bvh",
         "bvhpython_test_freebvh.bvh",
-    ] {
+    ]
+    .into_iter()
+    .map(|rig| {
         let take = read_bvh(&data.join("parser-cases").join(rig)).unwrap();
+        let take = trim(&take, 0..take.frame_count().min(frames)).unwrap();
         let on_bandai = Retargeting::detect(take.skeleton(), bandai.skeleton())
             .unwrap()
             .apply(&take)
             .unwrap();
         let back = Retargeting::detect(bandai.skeleton(), take.skeleton()).unwrap();
+        (rig, take, on_bandai, back)
+    })
+    .collect()
+}
+
+#[test]
+fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
+    let bandai = read_bvh(&sample_walk()).unwrap();
+    for (rig, take, on_bandai, back) in parser_cases_on_bandai(usize::MAX) {
         // Played back onto the take: the joints Bandai's rig lacks (fingers,
         // CMU's extra spine and hip joints) keep their own rotations.
         let restored = back.apply_onto(&on_bandai, &take).unwrap();
@@ -230,22 +244,7 @@ fn a_take_of_another_rig_played_by_bandai_and_back_onto_itself_is_unchanged() {
 
 #[test]
 fn a_change_made_on_bandai_is_carried_to_a_take_of_another_rig() {
-    let Some(data) = shared_data() else {
-        eprintln!("../shared/data is absent: skipped");
-        return;
-    };
-    let bandai = read_bvh(&sample_walk()).unwrap();
-    for rig in [
-        "dme_example_crlf_leadingdot_frametime.bvh",
-        "bvhpython_test_freebvh.bvh",
-    ] {
-        let take = read_bvh(&data.join("parser-cases").join(rig)).unwrap();
-        let take = trim(&take, 0..take.frame_count().min(60)).unwrap();
-        let on_bandai = Retargeting::detect(take.skeleton(), bandai.skeleton())
-            .unwrap()
-            .apply(&take)
-            .unwrap();
-        let back = Retargeting::detect(bandai.skeleton(), take.skeleton()).unwrap();
+    for (rig, take, on_bandai, back) in parser_cases_on_bandai(60) {
         // No change: the take comes back, channel for channel, although
         // the way there and back loses its extra joints' motion.
         let same = back.carry_change(&on_bandai, &on_bandai, &take).unwrap();
@@ -256,7 +255,7 @@ fn a_change_made_on_bandai_is_carried_to_a_take_of_another_rig() {
         }
         // Bandai's left knee bent by 20 degrees more: the take's knee turns
         // by that in the world, its thigh and its hands' fingers stay.
-        let knee_b = bandai.skeleton().find("LowerLeg_L").unwrap();
+        let knee_b = on_bandai.skeleton().find("LowerLeg_L").unwrap();
         let mut bent = on_bandai.clone();
         let turn = Quat::from_axis_angle(Vec3::Z, 20f32.to_radians());
         for f in 0..bent.frame_count() {
