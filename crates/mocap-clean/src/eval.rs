@@ -3,11 +3,16 @@
 //!
 //! Metrics, averaged over frames and joints, against the clean take:
 //! - rotation error: geodesic angle between the local joint rotations, in
-//!   degrees;
+//!   degrees, over every joint with rotations and over the joints of body
+//!   parts alone;
 //! - position error: mean per-joint position error after forward kinematics
 //!   (file units; centimetres for the Bandai Namco data);
 //! - acceleration error: mean norm of the difference of joint accelerations
 //!   (second finite differences of positions, units per frame^2).
+//!
+//! The noise conditions: synthetic ([`CONDITIONS`]), and with
+//! [`EvalOptions::fused`] the capture stage's ([`FUSED`]), where the clean
+//! take is the truth on the fused take's fitted skeleton.
 //!
 //! Classical filters are tuned per noise condition on validation takes (grid
 //! search for the lowest rotation error) and then run on the evaluation

@@ -306,7 +306,7 @@ impl ModelFile {
     }
 
     /// Whether `motion` is of another rig than the model's, which the model
-    /// cleans through its own ([`crate::rig`]).
+    /// cleans through its own (see `clean apply` in docs/clean-guide.md, "Takes of other rigs").
     pub fn cleans_through_its_rig(&self, motion: &Motion) -> bool {
         self.rig_for(motion).is_some()
     }

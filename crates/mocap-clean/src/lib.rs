@@ -121,7 +121,7 @@ pub use despike::{
 };
 pub use eval::{
     evaluate, noisy_take, parse_spike_lengths, EvalOptions, EvalReport, MethodMetrics, ModelEntry,
-    SpikeSurvival, TunedFilter, CONDITIONS,
+    SpikeSurvival, TunedFilter, CONDITIONS, FUSED,
 };
 pub use features::{FeatureLayout, Recentering, Representation, RotationFrame};
 pub use filters::{

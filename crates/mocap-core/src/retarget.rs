@@ -346,8 +346,8 @@ const BANDAI_RIG: &str = "Bandai Namco";
 
 /// The rig of `skeleton` in the canonical T-pose, one frame: from its rest
 /// pose (every rotation zero; for Bandai's rig, a natural pose of it,
-/// [`BANDAI_STANDING`]), each body part's bone swung, parents first,
-/// the shortest way onto its direction in a T-pose ([`canonical_direction`])
+/// `BANDAI_STANDING`), each body part's bone swung, parents first,
+/// the shortest way onto its direction in a T-pose (`canonical_direction`)
 /// in the body's axes of the rest pose (left-right from the hips, up from
 /// the pelvis to the top of the spine). A rig whose rest pose is a T-pose
 /// (CMU, Mixamo) stays as it is; an A-pose has its arms raised; a rest pose
