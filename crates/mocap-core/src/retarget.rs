@@ -96,8 +96,9 @@ pub struct Retargeting {
     roles: Vec<Role>,
     /// Target pelvis joint and source pelvis joint.
     pelvis: (usize, usize),
-    /// The target's root joint.
-    root: usize,
+    /// The target joint whose position channels move the body
+    /// ([`BodyMap::position_carrier`], else the root).
+    carrier: usize,
     scale: f32,
 }
 
@@ -504,9 +505,11 @@ impl Retargeting {
             target: target.clone(),
             roles,
             pelvis: (pelvis_t, pelvis_s),
-            root: (0..n)
-                .find(|&j| target.joint(j).parent.is_none())
-                .unwrap_or(0),
+            carrier: target_map.position_carrier(target).unwrap_or_else(|| {
+                (0..n)
+                    .find(|&j| target.joint(j).parent.is_none())
+                    .unwrap_or(0)
+            }),
             scale: leg_t / leg_s,
         })
     }
@@ -688,17 +691,13 @@ impl Retargeting {
             if onto.is_some() {
                 continue;
             }
-            // The pelvis goes where the source's is: by its own position
-            // channels where it has them (Bandai's rig keeps its root still
-            // and moves the pelvis), else by the root's; the world shift is
-            // taken into the axes of the moved joint's parent (turned when
-            // the joints above the pelvis are the source's own).
+            // The pelvis goes where the source's is, by the position
+            // channels that carry the body (Bandai's rig keeps its root
+            // still and moves the pelvis; most rigs move the root); the
+            // world shift is taken into the axes of the moved joint's parent
+            // (turned when the joints above the pelvis are the source's own).
             let shift = self.scale * source.position(f, pelvis_s) - positions[pelvis_t];
-            let moved = if self.target.joint(pelvis_t).has_position_channels() {
-                pelvis_t
-            } else {
-                self.root
-            };
+            let moved = self.carrier;
             let above = self
                 .target
                 .joint(moved)
