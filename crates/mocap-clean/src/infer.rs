@@ -35,7 +35,6 @@ use crate::features::{FeatureLayout, Representation};
 use crate::filters::{filter_motion, filter_translations, Filter};
 use crate::metrics::rotation_error_deg;
 use crate::model_file::{window_base, with_base_input, Base, CleanModel, ModelFile};
-use crate::rig::ModelRig;
 use crate::wiener::WienerOutcome;
 use crate::{CleanError, Result};
 
@@ -78,7 +77,7 @@ impl CleanModel {
         level_deg: Option<f64>,
     ) -> Result<(Motion, Option<WienerOutcome>)> {
         // A take of another rig goes through the model's own (`crate::rig`).
-        let layout = match (self.layout_for(motion), &self.rig) {
+        let layout = match (self.layout_for(motion), self.rig) {
             (Ok(layout), _) => layout,
             (Err(_), Some(rig)) => {
                 return rig.clean_through(motion, |played| {
@@ -293,7 +292,7 @@ impl ModelFile {
                 Ok((out, label))
             }
             ModelFile::Wiener(filter) => {
-                let (out, outcome) = match &rig {
+                let (out, outcome) = match rig {
                     Some(rig) => rig.clean_through(motion, |played| filter.clean(played, None))?,
                     None => filter.clean(motion, None)?,
                 };
@@ -302,29 +301,6 @@ impl ModelFile {
                     format!("Wiener filter{through} ({})", filter.describe(&outcome)),
                 ))
             }
-        }
-    }
-
-    /// Whether `motion` is of another rig than the model's, which the model
-    /// cleans through its own (see `clean apply` in docs/clean-guide.md, "Takes of other rigs").
-    pub fn cleans_through_its_rig(&self, motion: &Motion) -> bool {
-        self.rig_for(motion).is_some()
-    }
-
-    /// The model's rig, when `motion` is of another rig and the model
-    /// cleans such takes through its own.
-    fn rig_for(&self, motion: &Motion) -> Option<ModelRig> {
-        match self {
-            ModelFile::Network(model) => model
-                .layout_for(motion)
-                .is_err()
-                .then(|| model.rig.clone())
-                .flatten(),
-            ModelFile::Wiener(filter) => filter
-                .layout_for(motion)
-                .is_err()
-                .then(|| ModelRig::shipped_for(&filter.description.joints))
-                .flatten(),
         }
     }
 }
@@ -449,7 +425,7 @@ pub fn clean_file(options: &CleanOptions) -> Result<CleanReport> {
                 }
             };
             let start = Instant::now();
-            if model.cleans_through_its_rig(&motion) {
+            if model.rig_for(&motion).is_some() {
                 notes.push(format!(
                     "{} is not of the model's rig: it was cleaned through the model's rig \
                      (its body parts played there, the change carried back); on real takes of \

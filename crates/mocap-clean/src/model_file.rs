@@ -215,7 +215,7 @@ pub struct CleanModel {
     pub(crate) base_wiener: Option<WienerFilter>,
     /// The rig the model was trained on, when it is the shipped one: takes
     /// of other rigs are cleaned through it ([`crate::rig`]).
-    pub(crate) rig: Option<ModelRig>,
+    pub(crate) rig: Option<&'static ModelRig>,
 }
 
 impl std::fmt::Debug for CleanModel {
@@ -451,18 +451,22 @@ impl ModelFile {
     /// `motion`'s body parts), else the error [`ModelFile::clean`] would
     /// give.
     pub fn check_rig(&self, motion: &Motion) -> Result<()> {
+        match (self.rig_for(motion), self) {
+            (Some(rig), _) => rig.check(motion),
+            (None, ModelFile::Network(model)) => model.layout_for(motion).map(|_| ()),
+            (None, ModelFile::Wiener(filter)) => filter.layout_for(motion).map(|_| ()),
+        }
+    }
+
+    /// The model's rig, when `motion` is of another rig and the model
+    /// cleans such takes through its own ([`crate::rig`]).
+    pub(crate) fn rig_for(&self, motion: &Motion) -> Option<&'static ModelRig> {
         match self {
-            ModelFile::Network(model) => match (model.layout_for(motion), &model.rig) {
-                (Err(_), Some(rig)) => rig.check(motion),
-                (result, _) => result.map(|_| ()),
-            },
-            ModelFile::Wiener(filter) => match (
-                filter.layout_for(motion),
-                ModelRig::shipped_for(&filter.description.joints),
-            ) {
-                (Err(_), Some(rig)) => rig.check(motion),
-                (result, _) => result.map(|_| ()),
-            },
+            ModelFile::Network(model) => model.layout_for(motion).is_err().then_some(model.rig)?,
+            ModelFile::Wiener(filter) => filter
+                .layout_for(motion)
+                .is_err()
+                .then(|| ModelRig::shipped_for(&filter.description.joints))?,
         }
     }
 }

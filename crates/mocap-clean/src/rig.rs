@@ -24,6 +24,8 @@
 //! How well this cleans, rig by rig, is measured in bench/results/clean.md
 //! ("Other rigs").
 
+use std::sync::OnceLock;
+
 use mocap_core::bodymap::{BodyMap, BodyPart};
 use mocap_core::forward_kinematics;
 use mocap_core::io::bvh::read_bvh_from;
@@ -52,26 +54,27 @@ pub(crate) struct ModelRig {
 impl ModelRig {
     /// The shipped model's rig, when `joints` (the names of a model's joints
     /// with rotations, in order) are its joints: any model trained on
-    /// Bandai takes.
-    pub(crate) fn shipped_for(joints: &[String]) -> Option<ModelRig> {
-        let skeleton = read_bvh_from(
-            SHIPPED_RIG_BVH.as_bytes(),
-            "<built-in models/clean-rig.bvh>".as_ref(),
-        )
-        .expect("the built-in rig reads")
-        .skeleton()
-        .clone();
-        let names: Vec<&str> = skeleton
-            .joints()
-            .iter()
-            .filter(|j| j.has_rotation_channels())
-            .map(|j| j.name.as_str())
-            .collect();
-        if names != joints {
-            return None;
-        }
-        let map = BodyMap::detect(&skeleton).expect("the built-in rig's body parts are found");
-        Some(ModelRig { skeleton, map })
+    /// Bandai takes. Read once per process.
+    pub(crate) fn shipped_for(joints: &[String]) -> Option<&'static ModelRig> {
+        static SHIPPED: OnceLock<(ModelRig, Vec<String>)> = OnceLock::new();
+        let (rig, names) = SHIPPED.get_or_init(|| {
+            let skeleton = read_bvh_from(
+                SHIPPED_RIG_BVH.as_bytes(),
+                "<built-in models/clean-rig.bvh>".as_ref(),
+            )
+            .expect("the built-in rig reads")
+            .skeleton()
+            .clone();
+            let names = skeleton
+                .joints()
+                .iter()
+                .filter(|j| j.has_rotation_channels())
+                .map(|j| j.name.clone())
+                .collect();
+            let map = BodyMap::detect(&skeleton).expect("the built-in rig's body parts are found");
+            (ModelRig { skeleton, map }, names)
+        });
+        (names == joints).then_some(rig)
     }
 
     /// Cleans `motion`, a take of another rig, with `clean` (which cleans
@@ -183,7 +186,7 @@ mod tests {
 
     use super::*;
 
-    fn shipped() -> ModelRig {
+    fn shipped() -> &'static ModelRig {
         let rig = read_bvh_from(SHIPPED_RIG_BVH.as_bytes(), "rig".as_ref()).unwrap();
         let joints: Vec<String> = rig
             .skeleton()
