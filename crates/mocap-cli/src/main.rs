@@ -39,6 +39,8 @@ enum Command {
     Positions(commands::positions::Args),
     /// Multi-sensor capture: simulate, calibrate, fuse (offline or as a UDP server), write BVH, evaluate.
     Fuse(commands::fuse::Args),
+    /// Capture from calibrated RGB cameras: 2D keypoints triangulated by confidence, written as BVH.
+    Cameras(commands::cameras::Args),
     /// Denoise a take (learned model or classical filter); train and evaluate denoisers.
     Clean(Box<commands::clean::Args>),
     /// Keep planted feet still and above the floor: contacts found, legs turned by two-bone IK.
@@ -88,6 +90,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(args, &options),
         Command::Positions(args) => commands::positions::run(args, &options),
         Command::Fuse(args) => commands::fuse::run(args, &options),
+        Command::Cameras(args) => commands::cameras::run(args, &options),
         Command::Clean(args) => commands::clean::run(*args, &options),
         Command::Feet(args) => commands::feet::run(args, &options),
         Command::Search(args) => commands::search::run(args, &options),

@@ -123,7 +123,7 @@ impl Calibration {
         let file: CalibrationFile = toml::from_str(text).map_err(|e| {
             let (line, column) = e
                 .span()
-                .map(|s| line_column(text, s.start))
+                .map(|s| mocap_core::error::line_column(text, s.start))
                 .unwrap_or((1, 1));
             Error::Parse(mocap_core::ParseError {
                 location: mocap_core::error::Location {
@@ -218,13 +218,6 @@ impl Calibration {
     pub fn write(&self, path: &Path) -> Result<()> {
         mocap_core::io::atomic::write_bytes_atomically(path, self.to_toml_string().as_bytes())
     }
-}
-
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    (line, column)
 }
 
 #[cfg(test)]

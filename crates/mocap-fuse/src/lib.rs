@@ -128,7 +128,9 @@ pub use bvh::{
     FittedSkeleton,
 };
 pub use calib::{Calibration, RigidTransform, SensorPose};
-pub use confidence::{BoneLengthFunction, ConfidenceModel, RangeOfMotionTerm, StateWeights};
+pub use confidence::{
+    confidences, BoneLengthFunction, ConfidenceModel, RangeOfMotionTerm, StateWeights,
+};
 pub use eval::{
     consistency_markdown, evaluate, evaluate_consistency, evaluate_inputs, evaluate_recordings,
     evaluate_with, group_takes, report_markdown, simulated_fused_take, CalibrationError,

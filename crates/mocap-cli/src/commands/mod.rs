@@ -2,6 +2,7 @@
 //! libraries.
 
 pub mod args;
+pub mod cameras;
 pub mod clean;
 pub mod convert;
 pub mod demo;

@@ -9,16 +9,8 @@ use std::sync::RwLock;
 
 use super::names::{best_rig, find_joint, NameIndex};
 use super::{joint_list, BodyMap, BodyPart, FoundBy};
-use crate::error::{Error, ParseError, Result};
+use crate::error::{line_column, Error, ParseError, Result};
 use crate::skeleton::Skeleton;
-
-/// 1-based line and column of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
 
 /// A rig file, as written by users.
 #[derive(serde::Deserialize)]

@@ -1,0 +1,57 @@
+//! # mocap-cameras
+//!
+//! Capture from a few calibrated RGB cameras and a 2D pose estimator
+//! (OpenPose, AlphaPose, MediaPipe), as Pose2Sim, FreeMoCap or anipose do:
+//! per-camera 2D keypoints are triangulated into 3D joints, each view
+//! weighted by the fusion report's confidence (the keypoint's score in place
+//! of the tracking state, × bone-length agreement × range of motion), views
+//! that disagree are left out, and the joints are fitted to a BVH skeleton
+//! with mocap-fuse's fitter.
+//!
+//! What is here, from the bottom up:
+//! - cameras and their calibration ([`Camera`], [`CameraRig`],
+//!   [`read_calibration`]: Pose2Sim TOML, OpenCV YAML and JSON);
+//! - keypoint layouts and the 2D keypoint files ([`Layout`],
+//!   [`read_openpose_folder`]);
+//! - triangulation of one joint from several views ([`triangulate`]).
+
+mod associate;
+mod camera;
+mod capture;
+mod eval;
+mod keypoints;
+mod kinect;
+mod layout;
+mod sim;
+mod solve;
+mod trc;
+mod triangulate;
+
+// Front door: each module's re-exports.
+pub use associate::AssociationOptions;
+pub use camera::{read_calibration, write_calibration_toml, Camera, CameraRig};
+pub use capture::{
+    bone_spread, keypoint_reports, person_motion, read_trial, run_capture, triangulate_trial,
+    CaptureOptions, CaptureReport, KeypointReport, Person3d, PersonReport, Trial, SPREAD_BONES,
+};
+pub use eval::{
+    eval_markdown, evaluate_trial, CameraEvalOptions, CameraEvalReport, MethodResult,
+    ReferenceResult,
+};
+pub use keypoints::{
+    find_camera_folders, read_openpose_folder, write_openpose_frame, CameraKeypoints, Person2d,
+    ViewFrame,
+};
+pub use layout::{Layout, CANONICAL_NAMES, CANONICAL_PARENTS};
+pub use sim::{
+    simulate_cameras, simulate_to_folder, write_simulated_trial, CameraSimOptions, SimulatedTrial,
+    SimulationReport,
+};
+pub use solve::{
+    measure_person, triangulate_frame, Frame3d, Keypoint3d, Method, PersonModel,
+    TriangulationOptions,
+};
+pub use trc::{read_trc, trc_to_zup, write_trc, zup_to_trc, Markers};
+pub use triangulate::{
+    reprojection_error, triangulate, triangulate_robust, Sighting, Triangulated,
+};

@@ -1,0 +1,274 @@
+//! One point from several views: weighted linear triangulation, its
+//! reprojection error, and robust view selection.
+//!
+//! Each view sees the point at normalized, undistorted image coordinates
+//! `(x, y)` through its pose `P = [R | t]` (rows `P1, P2, P3`). The direct
+//! linear transform (Hartley & Zisserman, *Multiple View Geometry*, 2nd ed.,
+//! §12.2) stacks two equations a view,
+//!
+//! ```text
+//! w (x P3 - P1) · X = 0,    w (y P3 - P2) · X = 0,    X = (X, Y, Z, 1)
+//! ```
+//!
+//! and solves them in the least-squares sense. A view's weight `w` scales
+//! both of its equations, so a confident view pulls the point harder. With
+//! the fourth coordinate fixed at 1 (the inhomogeneous form, §12.2: every
+//! point is in front of the cameras, none at infinity) the solution is a 3×3
+//! linear system `M X = v` with `M = Σ r rᵀ` over the rows' first three
+//! entries, which is fast enough for thousands of frames a second.
+
+use glam::{DMat3, DVec2, DVec3};
+
+use crate::camera::Camera;
+
+/// One camera's sighting of a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sighting {
+    /// Index of the camera in the rig.
+    pub camera: usize,
+    /// Where the point is in the image, in pixels (as the pose estimator
+    /// wrote it, with the lens's distortion).
+    pub pixel: DVec2,
+    /// The same, undistorted and normalized (`x/z, y/z` in the camera).
+    pub normalized: DVec2,
+    /// How much this view counts (0 leaves it out).
+    pub weight: f64,
+}
+
+impl Sighting {
+    /// A sighting of `pixel` by `camera` (index `index`), with `weight`.
+    pub fn new(index: usize, camera: &Camera, pixel: DVec2, weight: f64) -> Sighting {
+        Sighting {
+            camera: index,
+            pixel,
+            normalized: camera.undistort(pixel),
+            weight,
+        }
+    }
+}
+
+/// The smallest determinant of the normal matrix, relative to its scale,
+/// for a solution: below it the rays are (nearly) parallel.
+const DEGENERATE: f64 = 1e-12;
+
+/// The point seen by `sightings` (weighted DLT, see the module
+/// documentation); `None` when fewer than two views have a weight or their
+/// rays are parallel.
+pub fn triangulate(cameras: &[Camera], sightings: &[Sighting]) -> Option<DVec3> {
+    let mut m = DMat3::ZERO;
+    let mut v = DVec3::ZERO;
+    let mut views = 0;
+    for s in sightings {
+        if s.weight <= 0.0 || !s.weight.is_finite() {
+            continue;
+        }
+        views += 1;
+        let p = cameras[s.camera].pose_matrix();
+        for (coordinate, row) in [(s.normalized.x, p[0]), (s.normalized.y, p[1])] {
+            // r = w (c P3 - Pi), split into its first three entries and the
+            // constant, which moves to the right-hand side.
+            let r = [
+                s.weight * (coordinate * p[2][0] - row[0]),
+                s.weight * (coordinate * p[2][1] - row[1]),
+                s.weight * (coordinate * p[2][2] - row[2]),
+                s.weight * (coordinate * p[2][3] - row[3]),
+            ];
+            let a = DVec3::new(r[0], r[1], r[2]);
+            m += outer(a, a);
+            v -= a * r[3];
+        }
+    }
+    if views < 2 {
+        return None;
+    }
+    let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
+    let det = m.determinant();
+    // (NaN fails this test too.)
+    if det.is_nan() || det.abs() <= DEGENERATE * scale {
+        return None;
+    }
+    let x = m.inverse() * v;
+    x.is_finite().then_some(x)
+}
+
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// Distance in pixels between where `point` projects in the sighting's
+/// camera and where it was seen; infinite when the point is behind it.
+pub fn reprojection_error(cameras: &[Camera], sighting: &Sighting, point: DVec3) -> f64 {
+    cameras[sighting.camera]
+        .project(point)
+        .map_or(f64::INFINITY, |p| p.distance(sighting.pixel))
+}
+
+/// A triangulated point and how well it fits its views.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Triangulated {
+    pub point: DVec3,
+    /// Mean reprojection error (pixels) over the views used.
+    pub error: f64,
+    /// The views used, as indices into the sightings given.
+    pub used: Vec<usize>,
+}
+
+/// Triangulates, then leaves out the view that fits worst while the mean
+/// reprojection error is above `max_error` pixels and more than
+/// `min_views` views remain (as Pose2Sim does, one view at a time).
+/// Sightings of zero weight never take part. `None` when fewer than
+/// `min_views` (at least 2) views are left or they do not meet.
+pub fn triangulate_robust(
+    cameras: &[Camera],
+    sightings: &[Sighting],
+    max_error: f64,
+    min_views: usize,
+) -> Option<Triangulated> {
+    let min_views = min_views.max(2);
+    let mut used: Vec<usize> = (0..sightings.len())
+        .filter(|&i| sightings[i].weight > 0.0)
+        .collect();
+    let mut subset: Vec<Sighting> = Vec::with_capacity(used.len());
+    loop {
+        if used.len() < min_views {
+            return None;
+        }
+        subset.clear();
+        subset.extend(used.iter().map(|&i| sightings[i]));
+        let point = triangulate(cameras, &subset)?;
+        let errors: Vec<f64> = subset
+            .iter()
+            .map(|s| reprojection_error(cameras, s, point))
+            .collect();
+        let error = errors.iter().sum::<f64>() / errors.len() as f64;
+        if error <= max_error {
+            return Some(Triangulated { point, error, used });
+        }
+        if used.len() == min_views {
+            // Views that still disagree: the point behind one of them is
+            // no point at all.
+            return error
+                .is_finite()
+                .then_some(Triangulated { point, error, used });
+        }
+        let worst = (0..errors.len())
+            .max_by(|&a, &b| errors[a].total_cmp(&errors[b]))
+            .expect("at least two views");
+        used.remove(worst);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A camera at `centre` looking at `target`, y down in the image as
+    /// OpenCV's cameras are, 1000 px focal length, 1000×1000 image.
+    pub(crate) fn looking_at(name: &str, centre: DVec3, target: DVec3) -> Camera {
+        let forward = (target - centre).normalize();
+        let right = forward.cross(DVec3::Z).normalize();
+        let down = forward.cross(right);
+        // Rows of R are the camera axes in world coordinates.
+        let rotation = DMat3::from_cols(right, down, forward).transpose();
+        Camera {
+            name: name.into(),
+            size: [1000.0, 1000.0],
+            matrix: DMat3::from_cols(
+                DVec3::new(1000.0, 0.0, 0.0),
+                DVec3::new(0.0, 1000.0, 0.0),
+                DVec3::new(500.0, 500.0, 1.0),
+            ),
+            distortion: [0.0; 5],
+            rotation,
+            translation: -(rotation * centre),
+        }
+    }
+
+    pub(crate) fn four_cameras() -> Vec<Camera> {
+        let target = DVec3::new(0.0, 0.0, 1.0);
+        (0..4)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::FRAC_PI_2 + 0.3;
+                looking_at(
+                    &format!("cam{i}"),
+                    DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 1.5),
+                    target,
+                )
+            })
+            .collect()
+    }
+
+    fn seen(cameras: &[Camera], point: DVec3, weight: f64) -> Vec<Sighting> {
+        cameras
+            .iter()
+            .enumerate()
+            .map(|(i, c)| Sighting::new(i, c, c.project(point).unwrap(), weight))
+            .collect()
+    }
+
+    #[test]
+    fn exact_sightings_give_the_point_back() {
+        let cameras = four_cameras();
+        for point in [
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.4, -0.3, 1.8),
+            DVec3::new(-0.5, 0.2, 0.05),
+        ] {
+            let x = triangulate(&cameras, &seen(&cameras, point, 1.0)).unwrap();
+            assert!(x.distance(point) < 1e-9, "{x} against {point}");
+            let t = triangulate(&cameras, &seen(&cameras[..2], point, 0.5)).unwrap();
+            assert!(t.distance(point) < 1e-9);
+        }
+    }
+
+    #[test]
+    fn one_view_or_parallel_rays_give_nothing() {
+        let cameras = four_cameras();
+        let point = DVec3::new(0.1, 0.1, 1.0);
+        assert!(triangulate(&cameras, &seen(&cameras[..1], point, 1.0)).is_none());
+        let mut two = seen(&cameras[..2], point, 1.0);
+        two[1].weight = 0.0;
+        assert!(triangulate(&cameras, &two).is_none());
+        // The same camera twice: the same ray.
+        let same = [cameras[0].clone(), cameras[0].clone()];
+        assert!(triangulate(&same, &seen(&same, point, 1.0)).is_none());
+    }
+
+    #[test]
+    fn a_weight_pulls_the_point_toward_the_confident_views() {
+        let cameras = four_cameras();
+        let point = DVec3::new(0.0, 0.0, 1.0);
+        let mut views = seen(&cameras, point, 1.0);
+        views[3].pixel += DVec2::new(40.0, 0.0);
+        views[3].normalized = cameras[3].undistort(views[3].pixel);
+        let equal = triangulate(&cameras, &views).unwrap();
+        views[3].weight = 0.1;
+        let weighted = triangulate(&cameras, &views).unwrap();
+        assert!(
+            weighted.distance(point) < 0.2 * equal.distance(point),
+            "{} against {}",
+            weighted.distance(point),
+            equal.distance(point)
+        );
+    }
+
+    #[test]
+    fn the_view_that_disagrees_is_left_out() {
+        let cameras = four_cameras();
+        let point = DVec3::new(0.2, 0.1, 1.2);
+        let mut views = seen(&cameras, point, 1.0);
+        views[1].pixel += DVec2::new(0.0, 80.0);
+        views[1].normalized = cameras[1].undistort(views[1].pixel);
+        let all = triangulate_robust(&cameras, &views, f64::INFINITY, 2).unwrap();
+        assert_eq!(all.used, vec![0, 1, 2, 3]);
+        assert!(all.error > 10.0);
+        let robust = triangulate_robust(&cameras, &views, 5.0, 2).unwrap();
+        assert_eq!(robust.used, vec![0, 2, 3]);
+        assert!(robust.point.distance(point) < 1e-9);
+        assert!(robust.error < 1e-6);
+        assert_eq!(
+            reprojection_error(&cameras, &views[1], robust.point).round(),
+            80.0
+        );
+    }
+}
