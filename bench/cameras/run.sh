@@ -17,17 +17,21 @@ P2S=$DATA/pose2sim-demo
 # chose in each view; `pose` the raw OpenPose output, where mocap finds the
 # person itself.
 for folder in pose-associated pose; do
-  for trial in S00_P00_SingleParticipant/S00_P00_T01_BalancingTrial S00_P00_SingleParticipant/S00_P00_T00_StaticTrial; do
-    name=$(basename "$trial")
-    ref=$(ls "$P2S/$trial"/pose-3d/*.trc | grep -v filt | head -1)
-    $MOCAP cameras eval "$P2S/$trial/$folder" --reference "$ref" \
-      --json --markdown "$OUT/pose2sim-$name-$folder.md" > "$OUT/pose2sim-$name-$folder.json"
+  trial=S00_P00_SingleParticipant/S00_P00_T01_BalancingTrial
+  $MOCAP cameras eval "$P2S/$trial/$folder" --reference "$P2S/$trial/pose-3d/S00_P00_T01_BalancingTrial_0-100.trc" \
+    --json --markdown "$OUT/pose2sim-balancing-$folder.md" > "$OUT/pose2sim-balancing-$folder.json"
+done
+# The two-person trial, raw OpenPose output: each person mocap finds against
+# each of Pose2Sim's two (the summary pairs them by distance).
+MULTI=$P2S/S00_P01_MultiParticipants/S00_P01_T02_Participants1-2
+for person in 1 2; do
+  for theirs in P1 P2; do
+    $MOCAP cameras eval "$MULTI/pose" --person $person \
+      --reference "$MULTI/pose-3d/S00_P01_T02_Participants1-2_${theirs}_0-100.trc" \
+      --json > "$OUT/multi-person$person-$theirs.json"
   done
 done
-# The two-person trial: both people written, each compared with Pose2Sim's.
-MULTI=$P2S/S00_P01_MultiParticipants/S00_P01_T02_Participants1-2
 tmp=$(mktemp -d)
-$MOCAP cameras run "$MULTI/pose" --people 2 -o "$tmp/multi.bvh" --json > "$OUT/pose2sim-multi-run.json"
 
 # 2. Simulated cameras on Bandai takes (one take of each of ten contents).
 for take in walk_normal_001 run_normal_001 dance-short_normal_001 kick_normal_001 bow_normal_001 \

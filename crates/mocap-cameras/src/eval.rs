@@ -24,6 +24,8 @@ pub struct CameraEvalOptions {
     /// Another tool's triangulation of the same trial (TRC, Pose2Sim's
     /// axes), compared marker by marker where names match.
     pub reference: Option<PathBuf>,
+    /// Which person to measure (0: the one found in the most frames).
+    pub person: usize,
 }
 
 /// One method's figures.
@@ -118,11 +120,13 @@ fn reprojection_all(
 pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
     let trial = read_trial(&options.capture)?;
     let names = trial.layout.names();
-    let tracks = tracks(&trial, 2, &options.capture.association);
-    let Some(track) = tracks.first() else {
+    let tracks = tracks(&trial, options.person + 2, &options.capture.association);
+    let Some(track) = tracks.get(options.person) else {
         return Err(Error::Invalid(format!(
-            "{}: nobody was seen consistently by two cameras",
-            options.capture.trial.display()
+            "{}: {} people were seen consistently by two cameras, person {} asked for",
+            options.capture.trial.display(),
+            tracks.len(),
+            options.person + 1
         )));
     };
     let detections: Vec<Vec<Option<&Person2d>>> = (0..trial.frames)

@@ -17,6 +17,7 @@ fn evaluate(folder: &Path) -> CameraEvalReport {
         capture: CaptureOptions::new(folder),
         truth: Some(folder.join("truth.trc")),
         reference: None,
+        person: 0,
     })
     .unwrap()
 }

@@ -182,15 +182,22 @@ struct EvalArgs {
     /// Another tool's triangulation of the same trial as TRC (Pose2Sim's pose-3d/*.trc).
     #[arg(long, value_name = "FILE")]
     reference: Option<PathBuf>,
+    /// Which person to measure: 1 is the one found in the most frames.
+    #[arg(long, default_value_t = 1)]
+    person: usize,
     #[command(flatten)]
     report: ReportArgs,
 }
 
 fn eval(args: EvalArgs, _options: &GlobalOptions) -> anyhow::Result<()> {
+    if args.person == 0 {
+        return Err(anyhow!("--person counts from 1"));
+    }
     let report = evaluate_trial(&CameraEvalOptions {
         capture: args.trial.capture(Method::Robust)?,
         truth: args.truth,
         reference: args.reference,
+        person: args.person - 1,
     })?;
     let markdown = eval_markdown(&report);
     if let Some(path) = &args.report.markdown {
