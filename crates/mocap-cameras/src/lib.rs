@@ -12,8 +12,23 @@
 //! - cameras and their calibration ([`Camera`], [`CameraRig`],
 //!   [`read_calibration`]: Pose2Sim TOML, OpenCV YAML and JSON);
 //! - keypoint layouts and the 2D keypoint files ([`Layout`],
-//!   [`read_openpose_folder`]);
-//! - triangulation of one joint from several views ([`triangulate`]).
+//!   [`read_openpose_folder`]), 3D markers as TRC ([`read_trc`]);
+//! - one point from several views ([`triangulate`], [`triangulate_robust`])
+//!   and one frame from every camera by confidence ([`triangulate_frame`],
+//!   [`Method`]);
+//! - a trial folder to BVH ([`run_capture`], `mocap cameras run`), the
+//!   simulator ([`simulate_to_folder`], `mocap cameras simulate`) and the
+//!   comparison of methods ([`evaluate_trial`], `mocap cameras eval`).
+//!
+//! Triangulate a Pose2Sim trial into a BVH file:
+//!
+//! ```no_run
+//! use mocap_cameras::{run_capture, CaptureOptions};
+//!
+//! let report = run_capture(&CaptureOptions::new("S00_P00_T01_BalancingTrial"), "take.bvh".as_ref())?;
+//! println!("{:.1} px", report.people[0].reprojection_px.unwrap_or(f64::NAN));
+//! # Ok::<(), mocap_core::Error>(())
+//! ```
 
 mod associate;
 mod camera;
