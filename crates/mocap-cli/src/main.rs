@@ -85,6 +85,8 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     }
+    // Sensor recordings (.skeleton, .jsonl) read as motions by every command.
+    mocap_fuse::register_recording_readers();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),

@@ -126,6 +126,9 @@ fn simulate_calibrate_measure_and_run_to_jsonl_and_bvh() {
             &s(&fused),
             "-o",
             &s(&bvh),
+            // In the truth's world, to compare with it (by default the BVH
+            // stands on the floor found under the feet).
+            "--calibration-world",
             "--json",
         ]
         .map(String::from),
@@ -692,4 +695,255 @@ fn errors_name_the_problem() {
         "magic",
     ]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn one_sensors_recording_is_a_motion_for_info_render_and_convert() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = dir.path().join("sim");
+    let out = mocap(&[
+        "fuse",
+        "simulate",
+        &sample(),
+        "--sensors",
+        "2",
+        "--ntu",
+        "-o",
+        &s(&sim),
+        "--json",
+    ]);
+    let report = json(&out);
+    let ntu: Vec<String> = report["files"]["ntu"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(ntu.len(), 2);
+    assert!(ntu[0].ends_with(".skeleton"), "{ntu:?}");
+    let frames = report["sensors"][0]["frames"].as_u64().unwrap();
+
+    // `mocap info` of one NTU file: the Kinect v2 skeleton at 30 fps.
+    let out = mocap(&["info", &ntu[0]]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Kinect"), "{text}");
+    assert!(text.contains("30.000 fps"), "{text}");
+    let info = json(&mocap(&["info", &ntu[0], "--json"]));
+    assert_eq!(info[0]["rig"], "Kinect v2");
+    // At least every frame the sensor kept (dropped ones are held).
+    assert!(info[0]["frames"].as_u64().unwrap() >= frames, "{info}");
+
+    // ... drawn as a filmstrip.
+    let png = dir.path().join("x.png");
+    let out = mocap(&["render", &ntu[0], "-o", &s(&png)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
+
+    // One sensor's JSON lines recording, as `fuse simulate` writes it, and
+    // the same sensor's NTU file, on the same grid.
+    let jsonl = s(&sim.join("sensor-0.jsonl"));
+    let out = mocap(&["info", &jsonl]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Kinect"));
+    let from_jsonl = json(&mocap(&["info", &jsonl, "--json"]));
+    assert_eq!(from_jsonl[0]["frames"], info[0]["frames"]);
+
+    // Written as BVH by `mocap convert`.
+    let bvh = dir.path().join("sensor-0.bvh");
+    let out = mocap(&["convert", &jsonl, &s(&bvh)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let back = json(&mocap(&["info", &s(&bvh), "--json"]));
+    assert_eq!(back[0]["frames"], info[0]["frames"]);
+
+    // Several sensors in one file: refused, naming them and `fuse run`.
+    let both = dir.path().join("both.jsonl");
+    let text = [0, 1]
+        .map(|k| std::fs::read_to_string(sim.join(format!("sensor-{k}.jsonl"))).unwrap())
+        .concat();
+    std::fs::write(&both, text).unwrap();
+    let out = mocap(&["info", &s(&both)]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(
+        err.contains("both.jsonl") && err.contains("ids 0, 1"),
+        "{err}"
+    );
+    assert!(err.contains("mocap fuse run"), "{err}");
+
+    // A file of no known type names the recordings among what is expected.
+    let out = mocap(&["info", &s(&sim.join("sensor-0.ply"))]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("unknown motion file type"), "{err}");
+    assert!(err.contains(".skeleton or .jsonl"), "{err}");
+}
+
+/// The simulator's NTU files, edited as a real NTU triple goes wrong.
+fn ntu_files(sim: &Path) -> Vec<PathBuf> {
+    (0..3)
+        .map(|k| sim.join(format!("S001C{k:03}P001R001A001.skeleton")))
+        .collect()
+}
+
+#[test]
+fn run_says_what_it_made_of_ntu_files() {
+    let (dir, sim) = simulated(&["--ntu"]);
+    let files = ntu_files(&sim);
+    // C000: a bystander, standing still, listed first in every frame.
+    let mut zero = mocap_fuse::read_ntu_skeleton(&files[0]).unwrap();
+    let first = zero.iter().flatten().next().unwrap().clone();
+    let bystander = mocap_fuse::NtuBody {
+        body_id: 7,
+        joints: first.joints.map(|j| mocap_fuse::JointObservation {
+            position: j.position + mocap_core::rotation::Vec3::new(1.5, 0.0, 0.3),
+            ..j
+        }),
+    };
+    for bodies in zero.iter_mut() {
+        bodies.insert(0, bystander.clone());
+    }
+    mocap_fuse::write_ntu_bodies(&files[0], &zero).unwrap();
+    // C001 started 2 frames late; C002 misses frames 30-39 and ends a
+    // frame early.
+    let mut one = mocap_fuse::read_ntu_skeleton(&files[1]).unwrap();
+    one.drain(..2);
+    mocap_fuse::write_ntu_bodies(&files[1], &one).unwrap();
+    let mut two = mocap_fuse::read_ntu_skeleton(&files[2]).unwrap();
+    for bodies in two[30..40].iter_mut() {
+        bodies.clear();
+    }
+    two.pop();
+    mocap_fuse::write_ntu_bodies(&files[2], &two).unwrap();
+
+    let fused = dir.path().join("fused.jsonl");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["fuse".to_string(), "run".into()];
+        args.extend(files.iter().map(|f| s(f)));
+        args.extend(
+            [
+                "--calib",
+                &s(&sim.join("truth.calib.toml")),
+                "--body",
+                &s(&sim.join("body.json")),
+                "-o",
+                &s(&fused),
+            ]
+            .map(String::from),
+        );
+        args.extend(extra.iter().map(|a| a.to_string()));
+        mocap(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let out = run(&[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let notes = stderr(&out);
+    assert!(
+        notes
+            .contains("note: C000: 2 people in view; kept body 72057594037927936 as the performer"),
+        "{notes}"
+    );
+    assert!(notes.contains(", dropped 7 ("), "{notes}");
+    assert!(notes.contains("note: C001 shifted +"), "{notes}");
+    assert!(notes.contains("to match C000, correlation"), "{notes}");
+    let gaps = notes
+        .lines()
+        .find(|l| l.starts_with("note: C002: no performer in"))
+        .unwrap_or_else(|| panic!("{notes}"));
+    // Frames 30-39 are a run (from 29 when the sensor dropped that one).
+    assert!(gaps.contains("30-39") || gaps.contains("29-39"), "{gaps}");
+    assert!(
+        notes.contains(&format!(
+            "note: the NTU files have different frame counts: C000 {}, C001 {}, C002 {}",
+            zero.len(),
+            one.len(),
+            two.len()
+        )),
+        "{notes}"
+    );
+    assert!(
+        !notes.contains("warning:"),
+        "the same person everywhere: {notes}"
+    );
+    // The same in the JSON report.
+    let report = json(&run(&["--json"]));
+    let offset = &report["recordings"]["time_offsets"][0];
+    assert_eq!(offset["sensor"], 1);
+    let frames = offset["frames"].as_f64().unwrap();
+    assert!((1.0..3.0).contains(&frames), "{offset}");
+    assert_eq!(
+        report["same_person"]["sensors"].as_array().unwrap().len(),
+        3
+    );
+    // Offsets switched off, or given; the input frame rate.
+    let out = run(&["--time-offsets", "off"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("shifted"), "{}", stderr(&out));
+    let out = run(&["--time-offsets", "0,2,0", "--input-fps", "30"]);
+    assert!(
+        stderr(&out).contains("note: C001 shifted +2.0 frames (66.7 ms) as given"),
+        "{}",
+        stderr(&out)
+    );
+    let out = run(&["--time-offsets", "0,2"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("2 time offsets given for 3 recordings"),
+        "{}",
+        stderr(&out)
+    );
+    let out = run(&["--time-offsets", "0,two"]);
+    assert_eq!(out.status.code(), Some(2), "a wrong command line");
+    let out = run(&["--input-fps", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("input frame rate must be positive"));
+}
+
+#[test]
+fn the_same_camera_or_file_twice_is_refused() {
+    let (dir, sim) = simulated(&["--ntu"]);
+    let files = ntu_files(&sim);
+    let other_take = dir.path().join("S001C001P001R002A001.skeleton");
+    std::fs::copy(&files[1], &other_take).unwrap();
+    let rig = s(&dir.path().join("rig.toml"));
+    let out = mocap(&[
+        "fuse",
+        "calibrate",
+        &s(&files[0]),
+        &s(&files[1]),
+        &s(&other_take),
+        "-o",
+        &rig,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(
+        err.contains("S001C001P001R001A001.skeleton and")
+            && err.contains("S001C001P001R002A001.skeleton are both sensor 1"),
+        "{err}"
+    );
+    let out = mocap(&[
+        "fuse",
+        "measure",
+        &s(&files[0]),
+        &s(&files[0]),
+        "-o",
+        &s(&dir.path().join("body.json")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("S001C000P001R001A001.skeleton is given twice"));
+    // One take's cameras calibrate, with what reading them did on stderr.
+    let out = mocap(&[
+        "fuse",
+        "calibrate",
+        &s(&files[0]),
+        &s(&files[1]),
+        &s(&files[2]),
+        "-o",
+        &rig,
+        "--input-fps",
+        "30",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("to match C000"), "{}", stderr(&out));
 }

@@ -655,6 +655,14 @@ pub struct BodySensorReport {
     /// spreads little and gives several degrees; capture a calibration take
     /// in which the person walks and turns.
     pub yaw_uncertainty_degrees: f64,
+    /// Standard deviations of the fitted rotation (degrees) and translation
+    /// (metres) when the 25 joints are drawn again with replacement
+    /// ([`joint_bootstrap`]): what the joints' own biases leave uncertain.
+    pub rotation_uncertainty_degrees: f64,
+    pub translation_uncertainty: f64,
+    /// Whether the consensus refinement replaced the first fit (`pairs`,
+    /// `inliers` and `rms` are then the refit's, as in the calibration file).
+    pub refined: bool,
 }
 
 /// The result of a calibration from the body, with one report per sensor.
@@ -886,10 +894,10 @@ pub fn calibrate_from_body(
         let (msrc, mdst) = joint_pairs(&settled, &|_| true);
         let mirrored = robust_fit(&msrc, &mdst, options, &mut rng);
         let mirrored_inliers = mirrored.as_ref().map_or(0, |m| m.1);
-        let best = match (fit, mirrored) {
-            (Some(f), Some(m)) if m.1 > f.1 => (m, msrc.len()),
-            (Some(f), _) => (f, src.len()),
-            (None, Some(m)) => (m, msrc.len()),
+        let (best, mirrored_won) = match (fit, mirrored) {
+            (Some(f), Some(m)) if m.1 > f.1 => ((m, msrc.len()), true),
+            (Some(f), _) => ((f, src.len()), false),
+            (None, Some(m)) => ((m, msrc.len()), true),
             (None, None) => {
                 return Err(Error::Invalid(format!(
                 "sensor {sensor}: no consistent transform found (the joints seen are degenerate)"
@@ -897,6 +905,13 @@ pub fn calibrate_from_body(
             }
         };
         let ((transform, inliers, rms), pairs) = best;
+        let (rotation_uncertainty_degrees, translation_uncertainty) = joint_bootstrap(
+            &settled,
+            mirrored_won,
+            &transform,
+            options.inlier_distance,
+            &mut rng,
+        );
         let yaw_uncertainty_degrees = {
             let inlier2 = options.inlier_distance * options.inlier_distance;
             let kept: Vec<Vec3> = src
@@ -931,10 +946,20 @@ pub fn calibrate_from_body(
             paired_frames,
             mirrored_inliers,
             yaw_uncertainty_degrees,
+            rotation_uncertainty_degrees,
+            translation_uncertainty,
+            refined: false,
         });
     }
     for _ in 0..options.consensus_rounds {
-        refine_by_consensus(streams, &mut calibration, reference, options, &mut rng);
+        for (sensor, pairs, inliers, rms) in
+            refine_by_consensus(streams, &mut calibration, reference, options, &mut rng)
+        {
+            // The report says what the calibration file holds.
+            if let Some(r) = reports.iter_mut().find(|r| r.sensor == sensor) {
+                (r.pairs, r.inliers, r.rms, r.refined) = (pairs, inliers, rms, true);
+            }
+        }
     }
     Ok(BodyCalibration {
         calibration,
@@ -951,13 +976,15 @@ pub fn calibrate_from_body(
 /// sensor takes the labelling (as reported or mirrored) closer to the
 /// consensus under the current transform. The pose is kept when the refit
 /// has fewer inliers than the current one.
+/// Returns, for each sensor whose refit was kept, its pairs, inliers and RMS.
 fn refine_by_consensus(
     streams: &SensorStreams,
     calibration: &mut Calibration,
     reference: u16,
     options: &BodyCalibrationOptions,
     rng: &mut StdRng,
-) {
+) -> Vec<(u16, usize, usize, f64)> {
+    let mut kept = Vec::new();
     let body = crate::body::BodyModel::measure(
         streams
             .streams
@@ -1025,9 +1052,68 @@ fn refine_by_consensus(
                     rms_residual: Some(rms),
                     pairs: Some(inliers),
                 });
+                kept.push((sensor, src.len(), inliers, rms));
             }
         }
     }
+    kept
+}
+
+/// Standard deviations of a body calibration's rotation (degrees) and
+/// translation (metres) by a bootstrap over joints: 50 times, 25 joints are
+/// drawn with replacement and the transform refitted (Kabsch, on the pairs
+/// of the drawn joints that are inliers of `transform`, over every frame).
+/// Joints, not frames, are the independent samples: a sensor's error at a
+/// joint is mostly a bias that repeats in every frame (see
+/// [`BodySensorReport::yaw_uncertainty_degrees`]); resampling frames would
+/// call a calibration sure that a second take moves by centimetres.
+fn joint_bootstrap(
+    frames: &[(Joints, Joints)],
+    mirrored: bool,
+    transform: &RigidTransform,
+    inlier_distance: f32,
+    rng: &mut StdRng,
+) -> (f64, f64) {
+    const ROUNDS: usize = 50;
+    let inlier2 = inlier_distance * inlier_distance;
+    let tracked = |a: &JointObservation| a.state == TrackingState::Tracked;
+    // Each joint's inlier pairs over the frames.
+    let by_joint: Vec<(Vec<Vec3>, Vec<Vec3>)> = (0..JOINT_COUNT)
+        .map(|n| {
+            let m = if mirrored { MIRROR[n] } else { n };
+            frames
+                .iter()
+                .filter(|(a, b)| tracked(&a[m]) && tracked(&b[n]))
+                .map(|(a, b)| (a[m].position, b[n].position))
+                .filter(|(p, q)| transform.apply(*p).distance_squared(*q) < inlier2)
+                .unzip()
+        })
+        .collect();
+    let (mut angle2, mut shift2, mut rounds) = (0.0f64, 0.0f64, 0usize);
+    for _ in 0..ROUNDS {
+        let (mut src, mut dst) = (Vec::new(), Vec::new());
+        for _ in 0..JOINT_COUNT {
+            let (s, d) = &by_joint[rng.random_range(0..JOINT_COUNT)];
+            src.extend_from_slice(s);
+            dst.extend_from_slice(d);
+        }
+        let Ok(fit) = fit_rigid(&src, &dst, None) else {
+            continue;
+        };
+        let turn = fit.transform.rotation * transform.rotation.inverse();
+        // The shorter way round (q and -q are one rotation).
+        let angle = 2.0 * (turn.normalize().w.abs().min(1.0) as f64).acos();
+        angle2 += angle.to_degrees().powi(2);
+        shift2 += (fit.transform.translation - transform.translation).length_squared() as f64;
+        rounds += 1;
+    }
+    if rounds == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    (
+        (angle2 / rounds as f64).sqrt(),
+        (shift2 / rounds as f64).sqrt(),
+    )
 }
 
 /// What `mocap fuse calibrate` reports of a calibration from the body.
@@ -1038,9 +1124,35 @@ pub struct BodyCalibrationReport {
     /// The sensor whose camera frame is the world.
     pub reference: u16,
     pub sensors: Vec<BodySensorReport>,
+    /// Whether every sensor's body is the same person once calibrated
+    /// ([`crate::check_same_person`]).
+    pub same_person: crate::offline::SamePersonReport,
 }
 
 impl BodyCalibrationReport {
+    /// Share of a sensor's joint pairs that fit below which the calibration
+    /// is suspect: the sensor may follow another person, or see the person
+    /// from a side the reference never sees.
+    pub const LOW_INLIER_SHARE: f64 = 0.5;
+
+    /// Warnings for the user: sensors whose body is another person, sensors
+    /// few of whose joint pairs fit.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = self.same_person.notes();
+        for s in &self.sensors {
+            let share = s.inliers as f64 / s.pairs.max(1) as f64;
+            if share < Self::LOW_INLIER_SHARE {
+                out.push(format!(
+                    "sensor {}: only {:.0}% of its joint pairs fit the reference's: it may follow \
+                     another person (check the bodies kept) or see a side the reference never sees",
+                    s.sensor,
+                    100.0 * share
+                ));
+            }
+        }
+        out
+    }
+
     /// Degrees of doubt about a sensor's turn about the vertical beyond which
     /// the person moved too little for a sure calibration.
     pub const UNSURE_DEGREES: f64 = 5.0;
@@ -1062,15 +1174,32 @@ pub fn calibrate_recordings(
     options: &BodyCalibrationOptions,
     output: &Path,
 ) -> Result<BodyCalibrationReport> {
-    let frames = crate::recording::read_recordings(recordings)?;
-    let streams = SensorStreams::new(frames);
+    let reading = crate::recording::ReadOptions::default();
+    Ok(calibrate_recordings_with(recordings, &reading, options, output)?.0)
+}
+
+/// [`calibrate_recordings`], the recordings read as `reading` says (the
+/// input frame rate of NTU files, time offsets:
+/// [`crate::read_recordings_with`]); also returns how they were read.
+pub fn calibrate_recordings_with(
+    recordings: &[PathBuf],
+    reading: &crate::recording::ReadOptions,
+    options: &BodyCalibrationOptions,
+    output: &Path,
+) -> Result<(BodyCalibrationReport, crate::recording::RecordingsReport)> {
+    let read = crate::recording::read_recordings_with(recordings, reading)?;
+    let streams = SensorStreams::new(read.frames);
     let found = calibrate_from_body(&streams, options)?;
     found.calibration.write(output)?;
-    Ok(BodyCalibrationReport {
+    let same_person =
+        crate::offline::check_same_person(&streams, &found.calibration, 1.0 / reading.input_fps);
+    let report = BodyCalibrationReport {
         calibration: output.to_path_buf(),
         reference: found.reference,
         sensors: found.sensors,
-    })
+        same_person,
+    };
+    Ok((report, read.report))
 }
 
 /// Two room scans to calibrate one against the other

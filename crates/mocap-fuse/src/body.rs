@@ -379,19 +379,33 @@ pub fn ranges_from_asf(asf: &std::path::Path) -> mocap_core::Result<Vec<Option<A
 /// `mocap fuse measure`: the person measured from recordings
 /// ([`BodyModel::measure`]), with the joint ranges taken from the limits of
 /// an ASF skeleton instead when `limits` is given ([`ranges_from_asf`]),
-/// written to `output`.
+/// written to `output`; the recordings are read with the default
+/// [`crate::ReadOptions`] ([`measure_recordings_with`]).
 pub fn measure_recordings(
     recordings: &[std::path::PathBuf],
     limits: Option<&std::path::Path>,
     output: &std::path::Path,
 ) -> mocap_core::Result<BodyModel> {
-    let frames = crate::recording::read_recordings(recordings)?;
+    let reading = crate::recording::ReadOptions::default();
+    Ok(measure_recordings_with(recordings, &reading, limits, output)?.0)
+}
+
+/// [`measure_recordings`], the recordings read as `reading` says
+/// ([`crate::read_recordings_with`]); also returns how they were read.
+pub fn measure_recordings_with(
+    recordings: &[std::path::PathBuf],
+    reading: &crate::recording::ReadOptions,
+    limits: Option<&std::path::Path>,
+    output: &std::path::Path,
+) -> mocap_core::Result<(BodyModel, crate::recording::RecordingsReport)> {
+    let read = crate::recording::read_recordings_with(recordings, reading)?;
+    let frames = read.frames;
     let mut body = BodyModel::measure(frames.iter().map(|f| &f.joints), MeasureOptions::default());
     if let Some(asf) = limits {
         body.ranges = ranges_from_asf(asf)?;
     }
     body.write(output)?;
-    Ok(body)
+    Ok((body, read.report))
 }
 
 /// The `q`-quantile of `samples` (sorted in place; nearest rank).

@@ -81,13 +81,16 @@ pub fn simulated_fused_take(
 }
 
 /// How the sensors' poses are known in the evaluation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CalibrationSource {
     /// The simulator's true poses.
     Truth,
     /// Calibrated from the body in the recordings ([`crate::align::calibrate_from_body`]).
     Body,
+    /// A calibration file (`mocap fuse calibrate`'s), for recordings: the
+    /// simulator of BVH takes places its own sensors.
+    File(PathBuf),
 }
 
 /// Options of `mocap fuse eval`.
@@ -388,8 +391,10 @@ pub fn evaluate_with(
                         }
                     }
                 }
-                let calibration = match options.calibration {
-                    CalibrationSource::Truth => sim.calibration(),
+                let calibration = match &options.calibration {
+                    // A file places real sensors, not the simulator's
+                    // (`evaluate_inputs` refuses it for BVH takes).
+                    CalibrationSource::Truth | CalibrationSource::File(_) => sim.calibration(),
                     CalibrationSource::Body => {
                         // Relative poses from the body; the world is put where
                         // the reference sensor truly is, so that the result
@@ -487,7 +492,7 @@ pub fn evaluate_with(
     Ok(EvalReport {
         clips,
         seeds: options.seeds.clone(),
-        calibration: options.calibration,
+        calibration: options.calibration.clone(),
         results,
         truth_jitter_mm: truth_jitter.0 / truth_jitter.1.max(1) as f64,
         state_shares: states.map(|s| s / total_states.max(1.0)),
@@ -541,13 +546,45 @@ pub fn evaluate_inputs(
     options: &EvalOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Evaluation> {
-    let recordings = options.inputs.iter().filter(|p| is_recording(p)).count();
-    if recordings == options.inputs.len() {
+    // A folder without BVH takes is a folder of recordings.
+    let mut inputs = Vec::new();
+    for input in &options.inputs {
+        let takes = input.is_dir()
+            && !mocap_core::io::find_files(std::slice::from_ref(input), &["bvh"])?.is_empty();
+        if input.is_dir() && !takes {
+            let found =
+                mocap_core::io::find_files(std::slice::from_ref(input), &["skeleton", "jsonl"])?;
+            if found.is_empty() {
+                return Err(Error::Invalid(format!(
+                    "{}: no BVH takes and no recordings (.skeleton, .jsonl) in this folder",
+                    input.display()
+                )));
+            }
+            inputs.extend(found);
+        } else {
+            inputs.push(input.clone());
+        }
+    }
+    let recordings = inputs.iter().filter(|p| is_recording(p)).count();
+    if recordings == inputs.len() {
+        let calibration = match &options.calibration {
+            CalibrationSource::File(path) => Some(Calibration::read(path)?),
+            // Recordings have no true calibration: from the body.
+            CalibrationSource::Body | CalibrationSource::Truth => None,
+        };
         Ok(Evaluation::Consistency(evaluate_recordings(
-            &options.inputs,
+            &inputs,
+            calibration.as_ref(),
             progress,
         )?))
     } else if recordings == 0 {
+        if let CalibrationSource::File(path) = &options.calibration {
+            return Err(Error::Invalid(format!(
+                "{}: a calibration file applies to recordings; BVH takes are watched by simulated \
+                 sensors the simulator places (truth) or that are calibrated from the body",
+                path.display()
+            )));
+        }
         Ok(Evaluation::Truth(evaluate_with(options, progress)?))
     } else {
         Err(Error::Invalid(
@@ -558,10 +595,12 @@ pub fn evaluate_inputs(
 
 /// The consistency evaluation ([`evaluate_consistency`]) of each take of the
 /// recordings ([`group_takes`]) with the `state`, `report` and `best`
-/// fusion methods at 30 fused frames per second. Calls `progress(done,
-/// total)` after each take.
+/// fusion methods at 30 fused frames per second, the sensors placed by
+/// `calibration` (or calibrated from the body of each take). Calls
+/// `progress(done, total)` after each take.
 pub fn evaluate_recordings(
     recordings: &[PathBuf],
+    calibration: Option<&Calibration>,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<ConsistencyReport>> {
     let takes = group_takes(recordings);
@@ -572,7 +611,13 @@ pub fn evaluate_recordings(
     let mut reports = Vec::new();
     for (take, files) in &takes {
         let frames = crate::recording::read_recordings(files)?;
-        reports.push(evaluate_consistency(take, frames, &methods, 30.0)?);
+        reports.push(evaluate_consistency(
+            take,
+            frames,
+            &methods,
+            30.0,
+            calibration,
+        )?);
         progress(reports.len(), takes.len());
     }
     Ok(reports)
@@ -853,6 +898,12 @@ pub struct ConsistencyRow {
     pub bone_error_mm: f64,
     /// Mean norm of the second difference of joint positions (mm/frame^2).
     pub jitter_mm: f64,
+    /// Left/right consistency: the mean difference between the lengths of
+    /// each left bone of [`CONSISTENCY_BONES`] and its right mirror in the
+    /// same frame (mm). People are close to symmetric, so a large value
+    /// says a joint was put on the wrong side or a limb was swapped.
+    #[serde(default)]
+    pub left_right_mm: f64,
 }
 
 /// The consistency evaluation of one take seen by several sensors.
@@ -860,7 +911,8 @@ pub struct ConsistencyRow {
 pub struct ConsistencyReport {
     pub take: String,
     pub sensors: Vec<u16>,
-    /// Calibration from the body, per sensor.
+    /// Calibration from the body, per sensor (empty when a calibration
+    /// file placed the sensors).
     pub calibration: Vec<crate::align::BodySensorReport>,
     pub rows: Vec<ConsistencyRow>,
 }
@@ -894,7 +946,25 @@ fn consistency_row(
             err_count += lengths.len();
         }
     }
+    let (mut asym_sum, mut asym_count) = (0.0, 0usize);
+    for &n in &CONSISTENCY_BONES {
+        let m = crate::kinect::MIRROR[n];
+        if m == n || !crate::kinect::JOINT_NAMES[n].ends_with("Left") {
+            continue;
+        }
+        let (pn, pm) = (
+            crate::kinect::PARENTS[n].expect("every listed bone has a parent"),
+            crate::kinect::PARENTS[m].expect("mirrors have parents"),
+        );
+        for (f, p) in poses.iter().enumerate() {
+            if [n, pn, m, pm].iter().all(|&j| seen(f, j)) {
+                asym_sum += (p[n].distance(p[pn]) - p[m].distance(p[pm])).abs() as f64;
+                asym_count += 1;
+            }
+        }
+    }
     ConsistencyRow {
+        left_right_mm: 1000.0 * asym_sum / asym_count.max(1) as f64,
         source,
         frames: poses.len(),
         bone_std_mm: 1000.0 * std_sum / bones.max(1) as f64,
@@ -914,6 +984,7 @@ pub fn evaluate_consistency(
     frames: Vec<crate::recording::SensorFrame>,
     methods: &[(String, FusionOptions)],
     fps: f64,
+    calibration: Option<&Calibration>,
 ) -> Result<ConsistencyReport> {
     let streams = SensorStreams::new(frames);
     streams.check_span(fps)?;
@@ -930,7 +1001,17 @@ pub fn evaluate_consistency(
             .flat_map(|s| s.iter().map(|f| &f.joints)),
         MeasureOptions::default(),
     );
-    let found = crate::align::calibrate_from_body(&streams, &Default::default())?;
+    let (calibration, calibration_report) = match calibration {
+        Some(given) => {
+            crate::offline::check_calibrated(&streams, given)
+                .map_err(|e| Error::Invalid(format!("{take}: {e}")))?;
+            (given.clone(), Vec::new())
+        }
+        None => {
+            let found = crate::align::calibrate_from_body(&streams, &Default::default())?;
+            (found.calibration, found.sensors)
+        }
+    };
     let mut rows = Vec::new();
     for (&sensor, frames) in &streams.streams {
         let poses: Vec<[Vec3; JOINT_COUNT]> = frames
@@ -949,14 +1030,14 @@ pub fn evaluate_consistency(
     }
     for (name, options) in methods {
         let mut fuser = Fuser::new(*options, body.clone());
-        let fused = fuse_streams(&streams, &found.calibration, &mut fuser, fps, None);
+        let fused = fuse_streams(&streams, &calibration, &mut fuser, fps, None);
         let poses: Vec<[Vec3; JOINT_COUNT]> = fused.iter().map(|f| f.joints).collect();
         rows.push(consistency_row(name.clone(), &poses, &|_, _| true, &body));
     }
     Ok(ConsistencyReport {
         take: take.to_string(),
         sensors: streams.streams.keys().copied().collect(),
-        calibration: found.sensors,
+        calibration: calibration_report,
         rows,
     })
 }
@@ -996,9 +1077,10 @@ pub fn group_takes(paths: &[PathBuf]) -> Vec<(String, Vec<PathBuf>)> {
 /// A consistency report as a Markdown table.
 pub fn consistency_markdown(reports: &[ConsistencyReport], command: &str) -> String {
     let mut s = format!(
-        "Command: `{command}`\n\nNo ground truth: sensors calibrated from the body; bone-length consistency over the take \
+        "Command: `{command}`\n\nNo ground truth: sensors calibrated from the body (or a given file); bone-length consistency over the take \
          (mean over {} bones of the standard deviation of each bone's length), its share of the mean length, the mean \
-         difference to the person's lengths measured from all sensors' Tracked joints, and jitter.\n",
+         difference to the person's lengths measured from all sensors' Tracked joints, the mean difference between left and \
+         right bones in the same frame, and jitter.\n",
         CONSISTENCY_BONES.len()
     );
     for r in reports {
@@ -1008,28 +1090,61 @@ pub fn consistency_markdown(reports: &[ConsistencyReport], command: &str) -> Str
         );
         for c in &r.calibration {
             s += &format!(
-                "sensor {} {} inliers of {} pairs (RMS {:.1} mm; mirrored hypothesis {} inliers; turn known to about {:.1} degrees); ",
+                "sensor {} {} inliers of {} pairs (RMS {:.1} mm; mirrored hypothesis {} inliers; pose known to about {:.1} degrees and {:.1} cm); ",
                 c.sensor,
                 c.inliers,
                 c.pairs,
                 c.rms * 1000.0,
                 c.mirrored_inliers,
-                c.yaw_uncertainty_degrees
+                c.rotation_uncertainty_degrees,
+                c.translation_uncertainty * 100.0
             );
         }
-        s += "\n\n| source | frames | bone length std (mm) | std / length (%) | length error (mm) | jitter (mm/frame^2) |\n";
-        s += "| --- | --- | --- | --- | --- | --- |\n";
+        if r.calibration.is_empty() {
+            s += "given as a file";
+        }
+        s += "\n\n| source | frames | bone length std (mm) | std / length (%) | length error (mm) | left - right (mm) | jitter (mm/frame^2) |\n";
+        s += "| --- | --- | --- | --- | --- | --- | --- |\n";
         for row in &r.rows {
             s += &format!(
-                "| {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |\n",
+                "| {} | {} | {:.1} | {:.2} | {:.1} | {:.1} | {:.2} |\n",
                 row.source,
                 row.frames,
                 row.bone_std_mm,
                 row.bone_cv_percent,
                 row.bone_error_mm,
+                row.left_right_mm,
                 row.jitter_mm
             );
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shin_longer_on_one_side_shows_in_the_left_right_figure_only_there() {
+        let pose = crate::body::tests::standing_pose();
+        let body = BodyModel::from_positions([&pose; 10], MeasureOptions::default());
+        let all = |_: usize, _: usize| true;
+        let even = consistency_row("even".into(), &[pose; 4], &all, &body);
+        assert!(even.left_right_mm < 1e-3, "{}", even.left_right_mm);
+        // The left ankle 8 cm further from its knee in every frame: no
+        // spread over time, 8 cm between the sides.
+        let mut uneven = pose;
+        let shin = (uneven[ANKLE_LEFT] - uneven[KNEE_LEFT]).normalize();
+        uneven[ANKLE_LEFT] += shin * 0.08;
+        uneven[FOOT_LEFT] += shin * 0.08;
+        let row = consistency_row("uneven".into(), &[uneven; 4], &all, &body);
+        // One of the six left bones differs: 80 mm over six.
+        assert!(
+            (row.left_right_mm - 80.0 / 6.0).abs() < 0.5,
+            "{}",
+            row.left_right_mm
+        );
+        assert!(row.bone_std_mm < 1e-3);
+    }
 }

@@ -19,9 +19,13 @@
 //! - recordings ([`SensorFrame`], [`read_recordings`]; NTU RGB+D
 //!   `.skeleton` files too) and the person measured beforehand
 //!   ([`BodyModel`]);
+//! - one sensor's recording as a motion ([`recording_motion`]; what `mocap
+//!   info`, `render`... read, [`register_recording_readers`]);
 //! - the fusion of one instant ([`Fuser`], [`FusionOptions`]), offline over
 //!   recordings ([`fuse_recordings`]) or live over UDP ([`serve`],
-//!   [`send`]), written as JSON lines or BVH ([`FusedOutputs`]);
+//!   [`send`]), written as JSON lines or BVH ([`FusedOutputs`]), the BVH
+//!   upright on the floor found under the feet ([`fit_floor`],
+//!   [`stand_on_floor`]);
 //! - sensor poses ([`Calibration`]) found from the body seen by every sensor
 //!   ([`calibrate_from_body`]) or from room scans ([`calibrate_from_points`]);
 //! - a Kinect v2 simulator on ground-truth takes ([`simulate_capture`]) and
@@ -53,7 +57,9 @@
 //! Fuse recorded sensors into a BVH file, as `mocap fuse run` does:
 //!
 //! ```no_run
-//! use mocap_fuse::{fuse_files, BoneLengthSource, FuseFilesOptions, FusionOptions, OutputFiles};
+//! use mocap_fuse::{
+//!     fuse_files, BoneLengthSource, BvhWorld, FuseFilesOptions, FusionOptions, OutputFiles,
+//! };
 //!
 //! let report = fuse_files(&FuseFilesOptions {
 //!     recordings: vec!["sensor-0.jsonl".into(), "sensor-1.jsonl".into()],
@@ -64,6 +70,7 @@
 //!         bvh_units_per_metre: 100.0,
 //!         bvh_lengths: BoneLengthSource::Fused,
 //!         feet: None,
+//!         bvh_world: BvhWorld::Floor,
 //!     },
 //!     fusion: FusionOptions::best(),
 //!     fps: 30.0,
@@ -103,6 +110,7 @@ mod bvh;
 mod calib;
 mod confidence;
 mod eval;
+mod floor;
 mod fusion;
 mod kinect;
 mod net;
@@ -111,16 +119,17 @@ mod output;
 mod ply;
 mod recording;
 mod sim;
+mod single;
 
 pub use align::{
-    calibrate_from_body, calibrate_from_points, calibrate_recordings, calibrate_scans, fit_rigid,
-    icp, read_point_pairs, Alignment, BodyCalibration, BodyCalibrationOptions,
-    BodyCalibrationReport, BodySensorReport, IcpMetric, IcpOptions, IcpResult, PointCalibration,
-    ScanCalibration, ScanPair,
+    calibrate_from_body, calibrate_from_points, calibrate_recordings, calibrate_recordings_with,
+    calibrate_scans, fit_rigid, icp, read_point_pairs, Alignment, BodyCalibration,
+    BodyCalibrationOptions, BodyCalibrationReport, BodySensorReport, IcpMetric, IcpOptions,
+    IcpResult, PointCalibration, ScanCalibration, ScanPair,
 };
 pub use body::{
-    measure_recordings, ranges_from_asf, ranges_from_limits, AngleDefinition, AngleRange,
-    BodyModel, MeasureOptions, ANGLES,
+    measure_recordings, measure_recordings_with, ranges_from_asf, ranges_from_limits,
+    AngleDefinition, AngleRange, BodyModel, MeasureOptions, ANGLES,
 };
 pub use bvh::{
     fit_error, fit_skeleton, fused_to_motion, fused_to_motion_with, poses_on_skeleton,
@@ -137,6 +146,10 @@ pub use eval::{
     CalibrationSource, ConsistencyReport, ConsistencyRow, EvalOptions, EvalReport, Evaluation,
     MethodResult, PerJointChart, PerJointSeries, CONSISTENCY_BONES,
 };
+pub use floor::{
+    fit_floor, floor_transform, stand_on_floor, BvhWorld, Floor, FloorMethod, FloorReport,
+    MIN_SPREAD, MIN_TRAVEL, TRIM_ITERATIONS,
+};
 pub use fusion::{
     facing_of, FusedFrame, Fuser, FusionOptions, OneEuroParams, SensorView, METHOD_NAMES,
 };
@@ -152,8 +165,9 @@ pub use net::{
     ServeFilesReport, ServeOptions, ServeReport, DEFAULT_MAX_SKEW, MAGIC, MAX_TIMESTAMP,
 };
 pub use offline::{
-    fuse_files, fuse_recordings, fuse_streams, views_at, FuseFilesOptions, FuseFilesReport,
-    SensorStreams, MAX_FUSED_FRAMES,
+    check_same_person, fuse_files, fuse_files_with, fuse_recordings, fuse_streams, views_at,
+    FuseFilesOptions, FuseFilesReport, PelvisDistance, SamePersonReport, SensorAgreement,
+    SensorStreams, MAX_FUSED_FRAMES, OTHER_PERSON_DISTANCE, SAME_INSTANT,
 };
 pub use output::{
     fused_frame_json, FrameSink, FusedOutputs, JsonlSink, MemorySink, OutputFiles, OutputFormat,
@@ -161,9 +175,14 @@ pub use output::{
 };
 pub use ply::{read_ply_points, write_ply_points, PlyEncoding};
 pub use recording::{
-    ntu_sensor_frames, read_any_recording, read_ntu_skeleton, read_ntu_skeleton_from,
-    read_recording, read_recordings, write_ntu_skeleton, write_recording, JointObservation,
-    NtuBody, SensorFrame, MAX_JOINT_DISTANCE, RECORDING_VERSION,
+    choose_ntu_body, estimate_time_offset, ntu_camera_of, ntu_performer_frames, ntu_sensor_frames,
+    read_any_recording, read_ntu_skeleton, read_ntu_skeleton_from, read_recording, read_recordings,
+    read_recordings_with, write_ntu_bodies, write_ntu_skeleton, write_recording, FrameRun,
+    JointObservation, NtuBody, NtuBodyChoice, NtuStitch, NtuTrack, OffsetEstimate, OffsetSource,
+    ReadOptions, RecordingFile, Recordings, RecordingsReport, SensorFrame, SensorIdSource,
+    TimeOffsetReport, TimeOffsets, MAX_JOINT_DISTANCE, MAX_OFFSET_FRAMES, MIN_OFFSET_CORRELATION,
+    NTU_FPS, PERFORMER_MIN_COVERAGE, RECORDING_VERSION, STITCH_MAX_GAP_SECONDS,
+    STITCH_METRES_PER_FRAME,
 };
 pub use sim::{
     center_truth, measure_person, room_points, sensor_point_cloud, simulate, simulate_capture,
@@ -171,3 +190,4 @@ pub use sim::{
     SimulatedSensorReport, Simulation, SimulationFiles, SimulationOptions, SimulationReport,
     SurfacePoint,
 };
+pub use single::{recording_motion, register_recording_readers};

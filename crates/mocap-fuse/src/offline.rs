@@ -12,14 +12,16 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use mocap_core::{Error, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::body::{BodyModel, MeasureOptions};
 use crate::calib::Calibration;
 use crate::fusion::{FusedFrame, Fuser, FusionOptions, SensorView};
 use crate::kinect::JOINT_COUNT;
 use crate::output::{FrameSink, FusedOutputs, OutputFiles, OutputReport};
-use crate::recording::{read_recordings, JointObservation, SensorFrame};
+use crate::recording::{
+    read_recordings_with, JointObservation, ReadOptions, Recordings, RecordingsReport, SensorFrame,
+};
 
 /// The most instants one fusion may have: as many as the channel values a
 /// motion may hold allow for the 25 joints' positions
@@ -102,14 +104,25 @@ impl SensorStreams {
     }
 }
 
+/// How close (a fraction of the frame period) an instant and a frame's
+/// time must be to count as the same instant: [`sample_stream`] then takes
+/// the frame as it is, and the fused grid ([`fuse_streams`],
+/// [`fuse_recordings`]) starts and ends on the frame. 1% of a period is
+/// a third of a millisecond at 30 frames per second: far below what a
+/// sensor's clock says, far above the rounding of a time written as text.
+pub const SAME_INSTANT: f64 = 0.01;
+
 /// A sensor's skeleton at instant `t` (camera space), interpolated between
-/// its frames; `None` when it has no frame close enough.
+/// its frames; `None` when it has no frame close enough. A frame within
+/// [`SAME_INSTANT`] of a period of `t` gives its own tracking states;
+/// between two frames each joint has the worse of their two states.
 pub fn sample_stream(
     frames: &[SensorFrame],
     t: f64,
     period: f64,
 ) -> Option<[JointObservation; JOINT_COUNT]> {
     let max_gap = 2.5 * period;
+    let same_instant = SAME_INSTANT * period;
     let i = frames.partition_point(|f| f.timestamp <= t);
     let before = i.checked_sub(1).map(|k| &frames[k]);
     let after = frames.get(i);
@@ -121,15 +134,29 @@ pub fn sample_stream(
             } else {
                 0.0
             };
+            // A frame at the instant (to within SAME_INSTANT of a period)
+            // is taken as it is, states included: whether the instant falls
+            // a hair before or after it (a time read from text, a clock a
+            // microsecond off) must not decide which neighbour's state it
+            // is judged by. Between frames, the worse of the two states.
+            let state_of = |n: usize| {
+                if t - a.timestamp <= same_instant {
+                    a.joints[n].state
+                } else if b.timestamp - t <= same_instant {
+                    b.joints[n].state
+                } else {
+                    a.joints[n].state.min(b.joints[n].state)
+                }
+            };
             Some(std::array::from_fn(|n| JointObservation {
                 position: a.joints[n].position.lerp(b.joints[n].position, w),
-                state: a.joints[n].state.min(b.joints[n].state),
+                state: state_of(n),
             }))
         }
         (a, b) => [a, b]
             .into_iter()
             .flatten()
-            .filter(|f| (f.timestamp - t).abs() <= 0.5 * period + 1e-9)
+            .filter(|f| (f.timestamp - t).abs() <= (0.5 + SAME_INSTANT) * period)
             .min_by(|x, y| (x.timestamp - t).abs().total_cmp(&(y.timestamp - t).abs()))
             .map(|f| f.joints),
     }
@@ -193,10 +220,13 @@ pub fn fuse_streams(
     };
     let period = 1.0 / fps;
     let t0 = start.unwrap_or(first);
-    let count = (((last - t0) * fps).floor().max(-1.0) as i64 + 1).min(MAX_FUSED_FRAMES as i64);
+    // The last frame's instant is fused even when rounding puts it a hair
+    // short of a whole number of periods from the start.
+    let count = (((last - t0) * fps + SAME_INSTANT).floor().max(-1.0) as i64 + 1)
+        .min(MAX_FUSED_FRAMES as i64);
     let mut out = Vec::with_capacity(count.max(0) as usize);
     for i in 0..count {
-        let t = t0 + i as f64 * period;
+        let t = t0 + i as f64 / fps;
         let views = views_at(streams, calibration, t, period);
         if let Some(f) = fuser.fuse(t, &views) {
             out.push(f);
@@ -246,28 +276,190 @@ pub fn fuse_recordings(
     fps: f64,
     sink: &mut dyn FrameSink,
 ) -> Result<usize> {
+    fuse_stream_set(&SensorStreams::new(frames), calibration, fuser, fps, sink)
+}
+
+/// [`fuse_recordings`] on frames already sorted into streams.
+fn fuse_stream_set(
+    streams: &SensorStreams,
+    calibration: &Calibration,
+    fuser: &mut Fuser,
+    fps: f64,
+    sink: &mut dyn FrameSink,
+) -> Result<usize> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(Error::Invalid(format!(
             "the fused frame rate must be positive, got {fps}"
         )));
     }
-    let streams = SensorStreams::new(frames);
     if streams.streams.is_empty() {
         return Err(Error::Invalid(
             "the recordings hold no sensor frames".into(),
         ));
     }
-    check_calibrated(&streams, calibration)?;
+    check_calibrated(streams, calibration)?;
     streams.check_span(fps)?;
     // Instants on multiples of the period, as the server fuses them, so that
-    // offline and live outputs (and ground truth) share their times.
-    let start = streams.span().map(|(first, _)| (first * fps).ceil() / fps);
-    let fused = fuse_streams(&streams, calibration, fuser, fps, start);
+    // offline and live outputs (and ground truth) share their times; the
+    // first frame's own instant when it is on one (to within SAME_INSTANT:
+    // a time a microsecond late must not lose the frame).
+    let start = streams
+        .span()
+        .map(|(first, _)| (first * fps - SAME_INSTANT).ceil() / fps);
+    let fused = fuse_streams(streams, calibration, fuser, fps, start);
     for f in &fused {
         sink.write(f)?;
     }
     sink.finish()?;
     Ok(fused.len())
+}
+
+/// The median pelvis distance (metres) between a sensor's body and the
+/// nearest other sensor's beyond which the sensor follows another person
+/// ([`check_same_person`]).
+pub const OTHER_PERSON_DISTANCE: f64 = 0.5;
+
+/// How far one frame's pelvis is from the nearest other sensor's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PelvisDistance {
+    /// The frame's time (s).
+    pub time: f64,
+    /// Metres, in the world of the calibration.
+    pub distance: f64,
+}
+
+/// One sensor's body against the others' ([`check_same_person`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorAgreement {
+    pub sensor: u16,
+    /// Per frame with a pelvis seen here and by another sensor at that
+    /// instant: the distance to the nearest other sensor's pelvis.
+    pub per_frame: Vec<PelvisDistance>,
+    /// Their median (`None`: no frame to compare).
+    pub median_distance: Option<f64>,
+    /// The median is beyond [`OTHER_PERSON_DISTANCE`]: this sensor's body
+    /// is another person (or its calibration is wrong).
+    pub other_person: bool,
+}
+
+/// Whether every sensor's body is the same person in the world
+/// ([`check_same_person`]).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SamePersonReport {
+    pub sensors: Vec<SensorAgreement>,
+}
+
+impl SamePersonReport {
+    /// The sensors whose body is another person.
+    pub fn other_people(&self) -> Vec<u16> {
+        self.sensors
+            .iter()
+            .filter(|s| s.other_person)
+            .map(|s| s.sensor)
+            .collect()
+    }
+
+    /// One sentence per sensor that follows another person; empty when all
+    /// agree.
+    pub fn notes(&self) -> Vec<String> {
+        let flagged: Vec<&SensorAgreement> =
+            self.sensors.iter().filter(|s| s.other_person).collect();
+        if flagged.len() > 1 && flagged.len() == self.sensors.len() {
+            let each: Vec<String> = flagged
+                .iter()
+                .map(|s| {
+                    format!(
+                        "sensor {} {:.2} m",
+                        s.sensor,
+                        s.median_distance.unwrap_or(f64::NAN)
+                    )
+                })
+                .collect();
+            return vec![format!(
+                "the sensors' bodies are not the same person: each is far from the others' (median pelvis distance: {}); which one follows the performer cannot be told",
+                each.join(", ")
+            )];
+        }
+        flagged
+            .iter()
+            .map(|s| {
+                format!(
+                    "sensor {}'s body is {:.2} m (median over {} frames) from the other sensors' bodies: it follows another person than they do (or its calibration is wrong)",
+                    s.sensor,
+                    s.median_distance.unwrap_or(f64::NAN),
+                    s.per_frame.len()
+                )
+            })
+            .collect()
+    }
+}
+
+/// Checks that every calibrated sensor's body is the same person: per frame
+/// of each sensor, the distance in the world between its pelvis
+/// (`SpineBase`, when not NotTracked) and the nearest pelvis of the other
+/// sensors at that instant ([`sample_stream`], frame period `period`). A
+/// sensor whose median distance is beyond [`OTHER_PERSON_DISTANCE`] follows
+/// another person; with two sensors, both are then far from each other and
+/// which one is wrong cannot be told. Uncalibrated sensors are left out.
+///
+/// For NTU files this checks the per-file choice of the performer
+/// ([`crate::choose_ntu_body`]) across the cameras, once they are
+/// calibrated.
+pub fn check_same_person(
+    streams: &SensorStreams,
+    calibration: &Calibration,
+    period: f64,
+) -> SamePersonReport {
+    use crate::kinect::{joint::SPINE_BASE, TrackingState};
+    let calibrated: Vec<(u16, &Vec<SensorFrame>, &crate::calib::RigidTransform)> = streams
+        .streams
+        .iter()
+        .filter_map(|(&s, frames)| Some((s, frames, calibration.get(s)?)))
+        .collect();
+    let seen = |j: &JointObservation| j.state != TrackingState::NotTracked;
+    let sensors = calibrated
+        .iter()
+        .map(|&(sensor, frames, pose)| {
+            let per_frame: Vec<PelvisDistance> = frames
+                .iter()
+                .filter(|f| seen(&f.joints[SPINE_BASE]))
+                .filter_map(|f| {
+                    let here = pose.apply(f.joints[SPINE_BASE].position);
+                    let distance = calibrated
+                        .iter()
+                        .filter(|(other, _, _)| *other != sensor)
+                        .filter_map(|(_, others, other_pose)| {
+                            let joints = sample_stream(others, f.timestamp, period)?;
+                            let pelvis = joints[SPINE_BASE];
+                            seen(&pelvis)
+                                .then(|| other_pose.apply(pelvis.position).distance(here) as f64)
+                        })
+                        .min_by(f64::total_cmp)?;
+                    Some(PelvisDistance {
+                        time: f.timestamp,
+                        distance,
+                    })
+                })
+                .collect();
+            let mut distances: Vec<f64> = per_frame.iter().map(|d| d.distance).collect();
+            distances.sort_by(f64::total_cmp);
+            let median_distance = (!distances.is_empty()).then(|| {
+                let n = distances.len();
+                if n % 2 == 1 {
+                    distances[n / 2]
+                } else {
+                    0.5 * (distances[n / 2 - 1] + distances[n / 2])
+                }
+            });
+            SensorAgreement {
+                sensor,
+                per_frame,
+                median_distance,
+                other_person: median_distance.is_some_and(|d| d > OTHER_PERSON_DISTANCE),
+            }
+        })
+        .collect();
+    SamePersonReport { sensors }
 }
 
 /// What `mocap fuse run` fuses, and where to.
@@ -296,13 +488,33 @@ pub struct FuseFilesReport {
     pub implausible_joints: usize,
     pub body_measured_from_recordings: bool,
     pub outputs: Vec<OutputReport>,
+    /// How the recordings were read: bodies kept and dropped, gaps, sensor
+    /// ids, time offsets ([`RecordingsReport::notes`]).
+    pub recordings: RecordingsReport,
+    /// Whether every sensor's body is the same person in the calibration's
+    /// world ([`check_same_person`]).
+    pub same_person: SamePersonReport,
 }
 
 /// `mocap fuse run`: fuses recordings with their calibration and the
-/// person's body ([`fuse_recordings`]) into the output files.
+/// person's body ([`fuse_recordings`]) into the output files; the
+/// recordings are read with the default [`ReadOptions`]
+/// ([`fuse_files_with`]).
 pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
+    fuse_files_with(options, &ReadOptions::default())
+}
+
+/// [`fuse_files`], the recordings read as `reading` says (the input frame
+/// rate of NTU files, time offsets: [`read_recordings_with`]).
+pub fn fuse_files_with(
+    options: &FuseFilesOptions,
+    reading: &ReadOptions,
+) -> Result<FuseFilesReport> {
     let calibration = Calibration::read(&options.calibration)?;
-    let mut frames = read_recordings(&options.recordings)?;
+    let Recordings {
+        mut frames,
+        report: recordings,
+    } = read_recordings_with(&options.recordings, reading)?;
     // Screened here, as the fusion would, so that the person is measured
     // without the outliers too, and they are counted.
     let implausible_joints = frames
@@ -318,13 +530,23 @@ pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
     };
     let mut outputs = FusedOutputs::open(&options.outputs, body.clone(), options.fps)?;
     let mut fuser = Fuser::new(options.fusion, body);
-    let count = fuse_recordings(frames, &calibration, &mut fuser, options.fps, &mut outputs)?;
+    let streams = SensorStreams::new(frames);
+    let count = fuse_stream_set(
+        &streams,
+        &calibration,
+        &mut fuser,
+        options.fps,
+        &mut outputs,
+    )?;
+    let same_person = check_same_person(&streams, &calibration, 1.0 / options.fps);
     Ok(FuseFilesReport {
         fused_frames: count,
         sensors,
         implausible_joints,
         body_measured_from_recordings: options.body.is_none(),
         outputs: outputs.reports().to_vec(),
+        recordings,
+        same_person,
     })
 }
 
@@ -332,6 +554,7 @@ pub fn fuse_files(options: &FuseFilesOptions) -> Result<FuseFilesReport> {
 mod tests {
     use super::*;
     use crate::kinect::TrackingState;
+    use crate::recording::TimeOffsets;
     use mocap_core::rotation::Vec3;
 
     fn frame(seq: u64, t: f64, x: f32, state: TrackingState) -> SensorFrame {
@@ -405,5 +628,164 @@ mod tests {
             err.contains("to 1000000000000000000000000000000 s (sensor 0 frame 7)"),
             "{err}"
         );
+    }
+
+    /// A simulated capture of the sample walk (3 sensors, NTU files too).
+    fn simulated() -> (tempfile::TempDir, crate::sim::SimulationFiles) {
+        let dir = tempfile::tempdir().unwrap();
+        let options = crate::sim::SimulationOptions {
+            sensors: 3,
+            seed: 2,
+            ..Default::default()
+        };
+        let report = crate::sim::simulate_to_folder(
+            &mocap_testdata::sample_walk(),
+            dir.path(),
+            &options,
+            None,
+            true,
+        )
+        .unwrap();
+        (dir, report.files)
+    }
+
+    /// `mocap fuse run`'s fusion (method `best`) of `frames` at 30 fps.
+    fn fused(frames: Vec<SensorFrame>, files: &crate::sim::SimulationFiles) -> Vec<FusedFrame> {
+        let calibration = Calibration::read(&files.calibration).unwrap();
+        let body = BodyModel::read(&files.body).unwrap();
+        let mut fuser = Fuser::new(FusionOptions::best(), body);
+        let mut sink = crate::output::MemorySink::default();
+        fuse_recordings(frames, &calibration, &mut fuser, 30.0, &mut sink).unwrap();
+        sink.frames
+    }
+
+    /// The largest distance (mm) between the joints of two fusions at the
+    /// same instants; both must have the same instants.
+    fn largest_difference_mm(a: &[FusedFrame], b: &[FusedFrame]) -> f64 {
+        assert_eq!(a.len(), b.len(), "as many fused frames");
+        a.iter()
+            .zip(b)
+            .flat_map(|(x, y)| {
+                assert!((x.time - y.time).abs() < 1e-3, "{} vs {}", x.time, y.time);
+                x.joints
+                    .iter()
+                    .zip(&y.joints)
+                    .map(|(p, q)| p.distance(*q) as f64 * 1000.0)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn ntu_frames(files: &crate::sim::SimulationFiles, time_offsets: TimeOffsets) -> Recordings {
+        let options = ReadOptions {
+            time_offsets,
+            ..Default::default()
+        };
+        crate::recording::read_recordings_with(&files.ntu, &options).unwrap()
+    }
+
+    #[test]
+    fn a_microsecond_on_every_time_moves_no_fused_joint() {
+        let (_dir, files) = simulated();
+        // NTU frames sit exactly on the fused instants, the worst case.
+        let frames = ntu_frames(&files, TimeOffsets::Off).frames;
+        let mut late = frames.clone();
+        for f in late.iter_mut() {
+            f.timestamp += 1e-6;
+        }
+        let moved = largest_difference_mm(&fused(frames, &files), &fused(late, &files));
+        eprintln!("a 1 us shift moves a fused joint by up to {moved:.4} mm");
+        assert!(moved < 1.0, "{moved} mm");
+    }
+
+    #[test]
+    fn skeleton_files_and_their_jsonl_fuse_alike() {
+        let (dir, files) = simulated();
+        let ntu = ntu_frames(&files, TimeOffsets::Off).frames;
+        // The same frames as .jsonl recordings (times i/30 s written as
+        // text and read back, positions to 0.1 mm).
+        let jsonl: Vec<PathBuf> = (0..3u16)
+            .map(|k| {
+                let path = dir.path().join(format!("C{k}.jsonl"));
+                let mine: Vec<SensorFrame> =
+                    ntu.iter().filter(|f| f.sensor == k).cloned().collect();
+                crate::recording::write_recording(&path, &mine).unwrap();
+                path
+            })
+            .collect();
+        let read = |offsets: TimeOffsets| {
+            let options = ReadOptions {
+                time_offsets: offsets,
+                ..Default::default()
+            };
+            crate::recording::read_recordings_with(&jsonl, &options).unwrap()
+        };
+        let from_jsonl = read(TimeOffsets::default()).frames;
+        let apart = largest_difference_mm(&fused(ntu, &files), &fused(from_jsonl, &files));
+        eprintln!(".skeleton and .jsonl fused up to {apart:.4} mm apart");
+        assert!(apart < 1.0, "{apart} mm");
+        // With the offsets estimated for the NTU files given to the .jsonl.
+        let estimated = ntu_frames(&files, TimeOffsets::default());
+        let given: Vec<f64> = (0..3u16)
+            .map(|k| {
+                estimated
+                    .report
+                    .time_offsets
+                    .iter()
+                    .find(|o| o.sensor == k && o.applied)
+                    .and_then(|o| o.frames)
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        assert!(given.iter().any(|x| *x != 0.0), "{given:?}");
+        let from_jsonl = read(TimeOffsets::Frames(given)).frames;
+        let apart =
+            largest_difference_mm(&fused(estimated.frames, &files), &fused(from_jsonl, &files));
+        assert!(apart < 1.0, "{apart} mm with the offsets");
+    }
+
+    #[test]
+    fn a_sensor_following_another_person_is_flagged() {
+        let (_dir, files) = simulated();
+        let calibration = Calibration::read(&files.calibration).unwrap();
+        let frames = crate::recording::read_recordings(&files.recordings).unwrap();
+        let period = 1.0 / 30.0;
+        let report = check_same_person(&SensorStreams::new(frames.clone()), &calibration, period);
+        assert_eq!(report.sensors.len(), 3);
+        for s in &report.sensors {
+            assert!(s.median_distance.unwrap() < 0.15, "{s:?}");
+            assert!(s.per_frame.len() > 150);
+        }
+        assert!(report.other_people().is_empty() && report.notes().is_empty());
+        // Sensor 2 follows someone 1.2 m to the side of the performer.
+        let mut other = frames.clone();
+        for f in other.iter_mut().filter(|f| f.sensor == 2) {
+            for j in f.joints.iter_mut() {
+                j.position += Vec3::new(1.2, 0.0, 0.0);
+            }
+        }
+        let report = check_same_person(&SensorStreams::new(other.clone()), &calibration, period);
+        assert_eq!(report.other_people(), vec![2]);
+        let median = |s: u16| {
+            report
+                .sensors
+                .iter()
+                .find(|a| a.sensor == s)
+                .unwrap()
+                .median_distance
+                .unwrap()
+        };
+        assert!(median(0) < 0.15 && median(1) < 0.15);
+        assert!((median(2) - 1.2).abs() < 0.2, "{}", median(2));
+        let notes = report.notes().join("\n");
+        assert!(
+            notes.contains("sensor 2's body is 1.") && notes.contains("follows another person"),
+            "{notes}"
+        );
+        // Two sensors: which one is wrong cannot be told.
+        other.retain(|f| f.sensor != 1);
+        let report = check_same_person(&SensorStreams::new(other), &calibration, period);
+        assert_eq!(report.other_people(), vec![0, 2]);
+        let notes = report.notes().join("\n");
+        assert!(notes.contains("cannot be told"), "{notes}");
     }
 }

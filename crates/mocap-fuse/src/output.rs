@@ -6,6 +6,13 @@
 //! The format of each output is chosen by its extension: `.jsonl` (or
 //! `.json`) for fused frames as JSON lines ([`fused_frame_json`]),
 //! `.bvh` for a motion on a fitted skeleton ([`crate::bvh`]).
+//!
+//! JSON lines keep the world of the calibration: the fused joints as fused
+//! (the reference sensor's camera frame for a calibration from the body).
+//! BVH files stand on the floor found under the feet by default
+//! ([`BvhWorld::Floor`], [`crate::floor`]): upright, `+y` up, the floor at
+//! `y = 0`, the first pelvis at `x = z = 0`, as other captures are; or keep
+//! the calibration's world ([`BvhWorld::Calibration`]).
 
 use std::path::{Path, PathBuf};
 
@@ -18,6 +25,7 @@ use crate::body::BodyModel;
 use crate::bvh::{
     fit_error, fused_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError,
 };
+use crate::floor::{fit_floor, floor_transform, BvhWorld, FloorReport};
 use crate::fusion::FusedFrame;
 
 /// Where fused frames go.
@@ -136,6 +144,12 @@ pub struct OutputReport {
     /// For a BVH with [`OutputFiles::feet`]: what the feet stage did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub feet: Option<FeetReport>,
+    /// For a BVH stood on the floor ([`BvhWorld::Floor`]): the floor found
+    /// and the transform from the calibration's world. `None` for JSON
+    /// lines, for [`BvhWorld::Calibration`], and when no floor was found
+    /// (the BVH then keeps the calibration's world).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor: Option<FloorReport>,
 }
 
 /// The files fused frames go to (`mocap fuse run` and `serve`), and how the
@@ -152,6 +166,9 @@ pub struct OutputFiles {
     /// Hold planted feet still and above the floor in the BVH files
     /// (mocap-feet, as `mocap feet`).
     pub feet: Option<FeetOptions>,
+    /// The BVH files' world: upright on the floor under the feet (default),
+    /// or the calibration's. JSON lines always keep the calibration's.
+    pub bvh_world: BvhWorld,
 }
 
 /// Fused frames to several outputs at once.
@@ -164,12 +181,15 @@ pub struct FusedOutputs {
     bvh_options: BvhOptions,
     lengths: BoneLengthSource,
     feet: Option<FeetOptions>,
+    world: BvhWorld,
     reports: Vec<OutputReport>,
 }
 
 impl FusedOutputs {
     /// Opens the outputs (JSON lines files are created now, BVH files are
     /// written by [`FrameSink::finish`]). `body` gives the BVH's bone lengths.
+    /// The BVH files stand on the floor ([`BvhWorld::Floor`]; see
+    /// [`FusedOutputs::with_world`]).
     pub fn create(paths: &[PathBuf], body: BodyModel, bvh_options: BvhOptions) -> Result<Self> {
         let mut jsonl = Vec::new();
         let mut bvh = Vec::new();
@@ -188,6 +208,7 @@ impl FusedOutputs {
             bvh_options,
             lengths: BoneLengthSource::Fused,
             feet: None,
+            world: BvhWorld::Floor,
             reports: Vec::new(),
         })
     }
@@ -199,7 +220,8 @@ impl FusedOutputs {
             fps,
         };
         let mut outputs = FusedOutputs::create(&files.paths, body, bvh_options)?
-            .with_bone_lengths(files.bvh_lengths);
+            .with_bone_lengths(files.bvh_lengths)
+            .with_world(files.bvh_world);
         outputs.feet = files.feet;
         Ok(outputs)
     }
@@ -208,6 +230,12 @@ impl FusedOutputs {
     /// take, [`BoneLengthSource::Fused`]).
     pub fn with_bone_lengths(mut self, lengths: BoneLengthSource) -> Self {
         self.lengths = lengths;
+        self
+    }
+
+    /// The BVH outputs' world (default: on the floor, [`BvhWorld::Floor`]).
+    pub fn with_world(mut self, world: BvhWorld) -> Self {
+        self.world = world;
         self
     }
 
@@ -238,6 +266,7 @@ impl FrameSink for FusedOutputs {
                 frames: self.written,
                 fit_error: None,
                 feet: None,
+                floor: None,
             });
         }
         self.jsonl.clear();
@@ -249,6 +278,14 @@ impl FrameSink for FusedOutputs {
                 "no fused frames: nothing to write to the BVH output".into(),
             ));
         }
+        let fps = self.bvh_options.fps;
+        let floor = match self.world {
+            // An unusable rate is refused by the BVH's fit below.
+            BvhWorld::Floor if fps.is_finite() && fps > 0.0 => {
+                stand_frames_on_floor(&mut self.frames, fps)
+            }
+            _ => None,
+        };
         let motion =
             fused_to_motion_with(&self.frames, &self.body, &self.bvh_options, self.lengths)?;
         let (motion, feet) = plant_feet_if_asked(motion, self.feet.as_ref())
@@ -264,8 +301,25 @@ impl FrameSink for FusedOutputs {
                 frames: motion.frame_count(),
                 fit_error: Some(error),
                 feet: feet.clone(),
+                floor,
             });
         }
         Ok(())
     }
+}
+
+/// Stands the fused frames on the floor under their feet ([`fit_floor`] on
+/// the frames as the BVH puts them on its grid of `fps`,
+/// [`floor_transform`]), in place; `None` (frames left as they are) when no
+/// floor is found.
+fn stand_frames_on_floor(frames: &mut [FusedFrame], fps: f64) -> Option<FloorReport> {
+    let poses = regular_poses(frames, fps);
+    let floor = fit_floor(&poses)?;
+    let transform = floor_transform(&poses, &floor);
+    for frame in frames.iter_mut() {
+        for p in frame.joints.iter_mut() {
+            *p = transform.apply(*p);
+        }
+    }
+    Some(FloorReport::new(floor, transform))
 }

@@ -8,9 +8,10 @@ use std::time::Duration;
 
 use anyhow::{bail, Context};
 use mocap_fuse::{
-    BodyCalibrationOptions, BodyCalibrationReport, BoneLengthSource, CalibrationSource,
+    BodyCalibrationOptions, BodyCalibrationReport, BoneLengthSource, BvhWorld, CalibrationSource,
     EvalOptions, Evaluation, FuseFilesOptions, FusionOptions, OutputFiles, OutputReport,
-    PerJointChart, ScanPair, SendOptions, ServeFilesOptions, SimulationOptions, METHOD_NAMES,
+    PerJointChart, ReadOptions, ScanPair, SendOptions, ServeFilesOptions, SimulationOptions,
+    TimeOffsets, METHOD_NAMES,
 };
 use serde::Serialize;
 
@@ -113,6 +114,7 @@ impl FusedBvhArgs {
             bvh_units_per_metre,
             bvh_lengths,
             feet: self.feet.options(),
+            bvh_world: BvhWorld::Floor,
         })
     }
 }
@@ -185,6 +187,41 @@ fn simulate(args: SimulateArgs, _options: &GlobalOptions) -> anyhow::Result<()> 
     Ok(())
 }
 
+/// How `calibrate`, `measure` and `run` read recordings.
+#[derive(clap::Args)]
+struct ReadingArgs {
+    /// Frames per second of NTU .skeleton files (their frame i is at i / FPS seconds).
+    #[arg(long, default_value_t = mocap_fuse::NTU_FPS, value_name = "FPS")]
+    input_fps: f64,
+    /// Time offsets: auto (each NTU file matched to the lowest camera by its motion), off, or
+    /// frames at --input-fps per file, in their order, added to their times (0,2,-1.5).
+    #[arg(
+        long,
+        default_value = "auto",
+        value_name = "auto|off|F,F,..",
+        allow_hyphen_values = true
+    )]
+    time_offsets: TimeOffsets,
+}
+
+impl ReadingArgs {
+    fn options(&self) -> ReadOptions {
+        ReadOptions {
+            input_fps: self.input_fps,
+            time_offsets: self.time_offsets.clone(),
+        }
+    }
+}
+
+/// What reading the recordings did that a person should know, on standard error.
+fn print_reading_notes(notes: &[String], options: &GlobalOptions) {
+    if !options.quiet {
+        for n in notes {
+            eprintln!("note: {n}");
+        }
+    }
+}
+
 // --------------------------------------------------------------- calibrate
 
 #[derive(clap::Args)]
@@ -215,6 +252,8 @@ struct CalibrateArgs {
     /// Sensor ids of the two scans (default: the number in each file name).
     #[arg(long, requires = "points", num_args = 2, value_names = ["A", "B"])]
     ids: Option<Vec<u16>>,
+    #[command(flatten)]
+    reading: ReadingArgs,
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
@@ -227,14 +266,16 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
     if args.recordings.is_empty() {
         bail!("give the recordings of the sensors (body calibration) or --points A.ply B.ply");
     }
-    let report = mocap_fuse::calibrate_recordings(
+    let (report, reading) = mocap_fuse::calibrate_recordings_with(
         &args.recordings,
+        &args.reading.options(),
         &BodyCalibrationOptions {
             reference: args.reference,
             ..Default::default()
         },
         &args.output,
     )?;
+    print_reading_notes(&reading.notes(), options);
     if args.json {
         return print_json(&report);
     }
@@ -245,13 +286,16 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
     );
     for s in &report.sensors {
         println!(
-            "  sensor {}: {} of {} joint pairs fit within 10 cm (RMS {:.1} mm), {} of {} frames with settled left/right, turn about the vertical known to about {:.1} degrees",
+            "  sensor {}: {} of {} joint pairs fit within 10 cm (RMS {:.1} mm{}), {} of {} frames with settled left/right; pose known to about {:.1} degrees and {:.1} cm (turn about the vertical {:.1} degrees)",
             s.sensor,
             s.inliers,
             s.pairs,
             s.rms * 1000.0,
+            if s.refined { ", refined on the other sensors' fused skeleton" } else { "" },
             s.settled_frames,
             s.paired_frames,
+            s.rotation_uncertainty_degrees,
+            s.translation_uncertainty * 100.0,
             s.yaw_uncertainty_degrees
         );
     }
@@ -260,6 +304,9 @@ fn calibrate(args: CalibrateArgs, options: &GlobalOptions) -> anyhow::Result<()>
             "warning: the person moved too little for a sure calibration from the body (over {} degrees of doubt); capture a take where they walk and turn, or refine with room scans (--points)",
             BodyCalibrationReport::UNSURE_DEGREES
         );
+    }
+    for warning in report.warnings() {
+        println!("warning: {warning}");
     }
     Ok(())
 }
@@ -328,14 +375,21 @@ struct MeasureArgs {
     /// Take the joint ranges from the limits of an ASF skeleton instead of measuring them.
     #[arg(long, value_name = "SKELETON.asf")]
     limits: Option<PathBuf>,
+    #[command(flatten)]
+    reading: ReadingArgs,
     /// Print the body as JSON.
     #[arg(long)]
     json: bool,
 }
 
-fn measure(args: MeasureArgs, _options: &GlobalOptions) -> anyhow::Result<()> {
-    let body =
-        mocap_fuse::measure_recordings(&args.recordings, args.limits.as_deref(), &args.output)?;
+fn measure(args: MeasureArgs, options: &GlobalOptions) -> anyhow::Result<()> {
+    let (body, reading) = mocap_fuse::measure_recordings_with(
+        &args.recordings,
+        &args.reading.options(),
+        args.limits.as_deref(),
+        &args.output,
+    )?;
+    print_reading_notes(&reading.notes(), options);
     if args.json {
         return print_json(&body);
     }
@@ -377,6 +431,11 @@ struct RunArgs {
     fps: f64,
     #[command(flatten)]
     bvh: FusedBvhArgs,
+    /// Write the BVH in the calibration's world (default: upright on the floor found under the feet).
+    #[arg(long)]
+    calibration_world: bool,
+    #[command(flatten)]
+    reading: ReadingArgs,
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
@@ -399,23 +458,48 @@ fn print_outputs(outputs: &[OutputReport]) {
         if let Some(feet) = &o.feet {
             println!("  {}", super::feet::summary(feet));
         }
+        if let Some(floor) = &o.floor {
+            let f = &floor.floor;
+            let side = if f.height <= 0.0 { "below" } else { "above" };
+            println!(
+                "  stood on the floor ({}; {} foot contacts): {:.1} degrees of tilt removed, the floor ({:.2} m {side} the calibration's origin) put at y = 0, the take moved {:.2} m along it to start at the origin",
+                f.method.describe(),
+                f.contacts_used,
+                f.tilt_degrees,
+                f.height.abs(),
+                floor.moved_along_floor
+            );
+        } else if o.format == mocap_fuse::OutputFormat::Bvh {
+            println!("  in the calibration's world");
+        }
     }
 }
 
 fn run_offline(args: RunArgs, options: &GlobalOptions) -> anyhow::Result<()> {
     let fusion = FusionOptions::preset(&args.method)?;
-    let outputs = args.bvh.outputs(args.output.clone())?;
+    let mut outputs = args.bvh.outputs(args.output.clone())?;
+    if args.calibration_world {
+        outputs.bvh_world = BvhWorld::Calibration;
+    }
     if args.body.is_none() && !options.quiet {
         eprintln!("note: no --body: the person's bone lengths and ranges are measured from these recordings");
     }
-    let report = mocap_fuse::fuse_files(&FuseFilesOptions {
-        recordings: args.recordings,
-        calibration: args.calib,
-        body: args.body,
-        outputs,
-        fusion,
-        fps: args.fps,
-    })?;
+    let reading = args.reading.options();
+    let report = mocap_fuse::fuse_files_with(
+        &FuseFilesOptions {
+            recordings: args.recordings,
+            calibration: args.calib,
+            body: args.body,
+            outputs,
+            fusion,
+            fps: args.fps,
+        },
+        &reading,
+    )?;
+    print_reading_notes(&report.recordings.notes(), options);
+    for n in report.same_person.notes() {
+        eprintln!("warning: {n}");
+    }
     if args.json {
         return print_json(&report);
     }
@@ -599,8 +683,8 @@ struct EvalArgs {
     /// Seeds per take and sensor count (BVH).
     #[arg(long, default_value = "1,2,3", value_delimiter = ',')]
     seeds: Vec<u64>,
-    /// How the sensor poses are known (BVH): the simulator's truth, or calibrated from the body.
-    #[arg(long, default_value = "truth", value_parser = ["truth", "body"])]
+    /// How the sensor poses are known: `truth` (BVH takes: the simulator's; recordings: from the body), `body` (calibrated from the body), or a calibration file (recordings).
+    #[arg(long, default_value = "truth", value_name = "truth|body|FILE")]
     calib: String,
     /// Also run methods with joint ranges from this ASF skeleton's limits (BVH).
     #[arg(long, value_name = "SKELETON.asf")]
@@ -621,10 +705,10 @@ fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         inputs: args.inputs,
         sensor_counts: args.sensors,
         seeds: args.seeds,
-        calibration: if args.calib == "body" {
-            CalibrationSource::Body
-        } else {
-            CalibrationSource::Truth
+        calibration: match args.calib.as_str() {
+            "truth" => CalibrationSource::Truth,
+            "body" => CalibrationSource::Body,
+            file => CalibrationSource::File(file.into()),
         },
         limits: args.limits,
         ..Default::default()

@@ -9,7 +9,7 @@ use super::GlobalOptions;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Motion files: BVH, or an ASF skeleton followed by its AMC motions.
+    /// Motion files: BVH, an ASF skeleton followed by its AMC motions, or one sensor's recording (.skeleton, .jsonl).
     #[arg(required = true)]
     files: Vec<PathBuf>,
     /// Print one JSON array with an object per motion.

@@ -6,7 +6,10 @@
 //! - [`atomic`]: writing a file so that it is either whole or absent.
 //!
 //! [`read_motion`] picks the reader from the file names, so that every
-//! command accepts the same inputs.
+//! command accepts the same inputs. Formats the core does not know (a
+//! capability's own, such as mocap-fuse's sensor recordings) join them
+//! through [`register_reader`]: every later [`read_motion`],
+//! [`read_motions`] and [`MotionSource::group`] in the process reads them.
 
 pub mod asf_amc;
 pub mod atomic;
@@ -14,6 +17,7 @@ pub mod bvh;
 pub mod positions;
 
 use std::path::{Path, PathBuf};
+use std::sync::RwLock;
 
 use crate::error::{Error, Result};
 use crate::motion::Motion;
@@ -25,13 +29,104 @@ pub enum MotionSource {
     Bvh(PathBuf),
     /// An ASF skeleton with one AMC motion of it.
     AsfAmc { asf: PathBuf, amc: PathBuf },
+    /// One file of a format given to the process with [`register_reader`],
+    /// read by the reader registered for its extension.
+    Registered(PathBuf),
+}
+
+/// A reader given to the whole process ([`register_reader`]).
+struct RegisteredReader {
+    /// Lower-case extensions, without the dot.
+    extensions: Vec<String>,
+    describe: &'static str,
+    read: fn(&Path) -> Result<Motion>,
+}
+
+/// Readers of the formats the core does not know, in the order they were
+/// given ([`register_reader`]).
+static REGISTERED_READERS: RwLock<Vec<RegisteredReader>> = RwLock::new(Vec::new());
+
+/// Built-in extensions: [`register_reader`] cannot take them over.
+const BUILT_IN: [&str; 3] = ["bvh", "asf", "amc"];
+
+/// Makes every later [`read_motion`], [`read_motions`] and
+/// [`MotionSource::group`] in this process read files ending in one of
+/// `extensions` (without the dot, matched in any case) with `read`:
+/// how a capability's own file format (mocap-fuse's sensor recordings)
+/// reaches every command that reads motions without the core depending on
+/// it. `describe` says what such a file is, for the error on a file of an
+/// unknown type ("a sensor recording"). An extension registered again is
+/// read by the latest reader (registering twice is harmless); the built-in
+/// extensions (`bvh`, `asf`, `amc`) keep their readers. Folder searches
+/// ([`find_files`], [`find_bvh_files`]) are not affected.
+///
+/// ```
+/// use mocap_core::io::{read_motion, register_reader};
+/// use mocap_core::{Error, Motion};
+///
+/// fn read_mine(path: &std::path::Path) -> mocap_core::Result<Motion> {
+///     Err(Error::Invalid(format!("{}: not implemented", path.display())))
+/// }
+/// register_reader(&["mine"], "my format", read_mine);
+/// let err = read_motion("take.mine".as_ref()).unwrap_err();
+/// assert!(err.to_string().contains("not implemented"));
+/// ```
+pub fn register_reader(
+    extensions: &[&'static str],
+    describe: &'static str,
+    read: fn(&Path) -> Result<Motion>,
+) {
+    let extensions: Vec<String> = extensions
+        .iter()
+        .map(|e| e.trim_start_matches('.').to_ascii_lowercase())
+        .filter(|e| !e.is_empty() && !BUILT_IN.contains(&e.as_str()))
+        .collect();
+    if extensions.is_empty() {
+        return;
+    }
+    let mut readers = REGISTERED_READERS
+        .write()
+        .unwrap_or_else(|e| e.into_inner());
+    // A later registration takes its extensions over from earlier ones.
+    for reader in readers.iter_mut() {
+        reader.extensions.retain(|e| !extensions.contains(e));
+    }
+    readers.retain(|r| !r.extensions.is_empty());
+    readers.push(RegisteredReader {
+        extensions,
+        describe,
+        read,
+    });
+}
+
+/// The reader registered for the lower-case `extension`, if any.
+fn registered_reader(extension: &str) -> Option<fn(&Path) -> Result<Motion>> {
+    REGISTERED_READERS
+        .read()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .find(|r| r.extensions.iter().any(|e| e == extension))
+        .map(|r| r.read)
+}
+
+/// What the error on a file of an unknown type says the readers expect:
+/// the built-in formats, then the registered ones.
+fn expected_types() -> String {
+    let mut expected = String::from("expected .bvh, or .asf followed by .amc");
+    let readers = REGISTERED_READERS.read().unwrap_or_else(|e| e.into_inner());
+    for reader in readers.iter() {
+        let extensions: Vec<String> = reader.extensions.iter().map(|e| format!(".{e}")).collect();
+        expected += &format!(", or {} ({})", extensions.join(" or "), reader.describe);
+    }
+    expected
 }
 
 impl MotionSource {
     /// Groups command-line paths into motions: each `.bvh` is one motion; an
     /// `.asf` pairs with every `.amc` that follows it (`X.asf A.amc B.amc`);
     /// an `.amc` with no `.asf` before it takes the one beside it
-    /// ([`asf_amc::skeleton_file_for`]).
+    /// ([`asf_amc::skeleton_file_for`]); a file of a registered format
+    /// ([`register_reader`]) is one motion.
     pub fn group(paths: &[PathBuf]) -> Result<Vec<MotionSource>> {
         let mut sources = Vec::new();
         let mut current_asf: Option<&PathBuf> = None;
@@ -48,10 +143,14 @@ impl MotionSource {
                     },
                     amc: path.clone(),
                 }),
+                other if registered_reader(other).is_some() => {
+                    sources.push(MotionSource::Registered(path.clone()))
+                }
                 _ => {
                     return Err(Error::Invalid(format!(
-                        "{}: unknown motion file type (expected .bvh, or .asf followed by .amc)",
-                        path.display()
+                        "{}: unknown motion file type ({})",
+                        path.display(),
+                        expected_types()
                     )))
                 }
             }
@@ -75,6 +174,7 @@ impl MotionSource {
         match self {
             MotionSource::Bvh(p) => p.display().to_string(),
             MotionSource::AsfAmc { amc, .. } => amc.display().to_string(),
+            MotionSource::Registered(path) => path.display().to_string(),
         }
     }
 
@@ -89,7 +189,7 @@ impl MotionSource {
                 let (_, frames, frame_time) = bvh::read_bvh_header(path)?;
                 Ok(Some((frames, frame_time)))
             }
-            MotionSource::AsfAmc { .. } => Ok(None),
+            MotionSource::AsfAmc { .. } | MotionSource::Registered(_) => Ok(None),
         }
     }
 
@@ -97,6 +197,14 @@ impl MotionSource {
         match self {
             MotionSource::Bvh(path) => bvh::read_bvh(path),
             MotionSource::AsfAmc { asf, amc } => asf_amc::read_asf_amc(asf, amc),
+            MotionSource::Registered(path) => match registered_reader(&extension(path)) {
+                Some(read) => read(path),
+                None => Err(Error::Invalid(format!(
+                    "{}: no reader is registered for this file type ({})",
+                    path.display(),
+                    expected_types()
+                ))),
+            },
         }
     }
 }
@@ -109,8 +217,9 @@ pub fn read_motions(paths: &[PathBuf]) -> Result<Vec<(MotionSource, Motion)>> {
         .collect()
 }
 
-/// Reads one motion file: a BVH file, or an AMC motion with the ASF
-/// skeleton beside it ([`asf_amc::skeleton_file_for`]).
+/// Reads one motion file: a BVH file, an AMC motion with the ASF skeleton
+/// beside it ([`asf_amc::skeleton_file_for`]), or a file of a registered
+/// format ([`register_reader`]).
 pub fn read_motion(path: &Path) -> Result<Motion> {
     // One path groups into one motion or an error (a lone `.asf` is one).
     let source = MotionSource::group(&[path.to_path_buf()])?
