@@ -630,25 +630,6 @@ mod tests {
         );
     }
 
-    /// A simulated capture of the sample walk (3 sensors, NTU files too).
-    fn simulated() -> (tempfile::TempDir, crate::sim::SimulationFiles) {
-        let dir = tempfile::tempdir().unwrap();
-        let options = crate::sim::SimulationOptions {
-            sensors: 3,
-            seed: 2,
-            ..Default::default()
-        };
-        let report = crate::sim::simulate_to_folder(
-            &mocap_testdata::sample_walk(),
-            dir.path(),
-            &options,
-            None,
-            true,
-        )
-        .unwrap();
-        (dir, report.files)
-    }
-
     /// `mocap fuse run`'s fusion (method `best`) of `frames` at 30 fps.
     fn fused(frames: Vec<SensorFrame>, files: &crate::sim::SimulationFiles) -> Vec<FusedFrame> {
         let calibration = Calibration::read(&files.calibration).unwrap();
@@ -685,7 +666,7 @@ mod tests {
 
     #[test]
     fn a_microsecond_on_every_time_moves_no_fused_joint() {
-        let (_dir, files) = simulated();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         // NTU frames sit exactly on the fused instants, the worst case.
         let frames = ntu_frames(&files, TimeOffsets::Off).frames;
         let mut late = frames.clone();
@@ -699,7 +680,7 @@ mod tests {
 
     #[test]
     fn skeleton_files_and_their_jsonl_fuse_alike() {
-        let (dir, files) = simulated();
+        let (dir, files) = crate::sim::simulated_walk_files();
         let ntu = ntu_frames(&files, TimeOffsets::Off).frames;
         // The same frames as .jsonl recordings (times i/30 s written as
         // text and read back, positions to 0.1 mm).
@@ -745,7 +726,7 @@ mod tests {
 
     #[test]
     fn a_sensor_following_another_person_is_flagged() {
-        let (_dir, files) = simulated();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         let calibration = Calibration::read(&files.calibration).unwrap();
         let frames = crate::recording::read_recordings(&files.recordings).unwrap();
         let period = 1.0 / 30.0;

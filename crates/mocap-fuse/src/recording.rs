@@ -1800,34 +1800,13 @@ mod tests {
         assert!(err.contains("unexpected end of file"), "{err}");
     }
 
-    /// The simulator's NTU files of the sample walk (3 sensors, cameras
-    /// C000-C002, 194 frames) in a temporary folder, with the sensors'
-    /// recordings (their true times).
-    fn simulated_ntu() -> (tempfile::TempDir, crate::sim::SimulationFiles) {
-        let dir = tempfile::tempdir().unwrap();
-        let options = crate::sim::SimulationOptions {
-            sensors: 3,
-            seed: 2,
-            ..Default::default()
-        };
-        let report = crate::sim::simulate_to_folder(
-            &mocap_testdata::sample_walk(),
-            dir.path(),
-            &options,
-            None,
-            true,
-        )
-        .unwrap();
-        (dir, report.files)
-    }
-
     fn body_of(bodies: &[NtuBody], id: u64) -> Option<&NtuBody> {
         bodies.iter().find(|b| b.body_id == id)
     }
 
     #[test]
     fn a_second_person_listed_first_is_not_followed() {
-        let (_dir, files) = simulated_ntu();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         let path = &files.ntu[1];
         let mut frames = read_ntu_skeleton(path).unwrap();
         let first = frames.iter().flatten().next().unwrap().clone();
@@ -1872,7 +1851,7 @@ mod tests {
 
     #[test]
     fn a_body_id_changing_mid_take_is_stitched() {
-        let (_dir, files) = simulated_ntu();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         let path = &files.ntu[0];
         let mut frames = read_ntu_skeleton(path).unwrap();
         let old = frames.iter().flatten().next().unwrap().body_id;
@@ -1985,7 +1964,7 @@ mod tests {
 
     #[test]
     fn frames_without_the_performer_and_frame_counts_are_reported() {
-        let (_dir, files) = simulated_ntu();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         // 194 frames each (a sensor that dropped its last frames wrote
         // fewer); then C001 loses the performer in frames 30-39, C002
         // starts with 5 empty frames and is one frame shorter.
@@ -2045,7 +2024,7 @@ mod tests {
 
     #[test]
     fn a_camera_started_late_is_shifted_back_by_its_motion() {
-        let (_dir, files) = simulated_ntu();
+        let (_dir, files) = crate::sim::simulated_walk_files();
         // C001 started 2 frames late: its frame i is the others' frame i + 2.
         let mut one = read_ntu_skeleton(&files.ntu[1]).unwrap();
         one.drain(..2);
@@ -2133,7 +2112,7 @@ mod tests {
 
     #[test]
     fn the_same_camera_or_file_twice_is_an_error_naming_both() {
-        let (dir, files) = simulated_ntu();
+        let (dir, files) = crate::sim::simulated_walk_files();
         let other_take = dir.path().join("S001C001P001R002A001.skeleton");
         std::fs::copy(&files.ntu[1], &other_take).unwrap();
         let paths = [files.ntu[0].clone(), files.ntu[1].clone(), other_take];
@@ -2170,7 +2149,7 @@ mod tests {
 
     #[test]
     fn files_without_a_camera_number_get_the_next_free_ids() {
-        let (dir, files) = simulated_ntu();
+        let (dir, files) = crate::sim::simulated_walk_files();
         // Real NTU cameras are numbered from 1.
         let c1 = dir.path().join("S001C001P001R001A001.skeleton");
         let c2 = dir.path().join("S001C002P001R001A001.skeleton");
