@@ -796,6 +796,28 @@ pub fn simulate_to_folder(
     })
 }
 
+/// For tests of other modules: the sample walk seen by three simulated
+/// sensors (seed 2), written with its NTU files (cameras C000-C002, 194
+/// frames) into a temporary folder that lives as long as the first value.
+#[cfg(test)]
+pub(crate) fn simulated_walk_files() -> (tempfile::TempDir, SimulationFiles) {
+    let dir = tempfile::tempdir().unwrap();
+    let options = SimulationOptions {
+        sensors: 3,
+        seed: 2,
+        ..Default::default()
+    };
+    let report = simulate_to_folder(
+        &mocap_testdata::sample_walk(),
+        dir.path(),
+        &options,
+        None,
+        true,
+    )
+    .unwrap();
+    (dir, report.files)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -834,26 +856,4 @@ mod tests {
         );
         assert!(facing_of(&pose).dot(Vec3::Z) > 0.9, "{}", facing_of(&pose));
     }
-}
-
-/// For tests of other modules: the sample walk seen by three simulated
-/// sensors (seed 2), written with its NTU files (cameras C000-C002, 194
-/// frames) into a temporary folder that lives as long as the first value.
-#[cfg(test)]
-pub(crate) fn simulated_walk_files() -> (tempfile::TempDir, SimulationFiles) {
-    let dir = tempfile::tempdir().unwrap();
-    let options = SimulationOptions {
-        sensors: 3,
-        seed: 2,
-        ..Default::default()
-    };
-    let report = simulate_to_folder(
-        &mocap_testdata::sample_walk(),
-        dir.path(),
-        &options,
-        None,
-        true,
-    )
-    .unwrap();
-    (dir, report.files)
 }
