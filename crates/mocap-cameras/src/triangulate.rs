@@ -113,11 +113,21 @@ pub struct Triangulated {
     pub used: Vec<usize>,
 }
 
-/// Triangulates, then leaves out the view that fits worst while the mean
-/// reprojection error is above `max_error` pixels and more than
-/// `min_views` views remain (as Pose2Sim does, one view at a time).
-/// Sightings of zero weight never take part. `None` when fewer than
-/// `min_views` (at least 2) views are left or they do not meet.
+/// The most views a keypoint is triangulated from by trying every subset
+/// of them ([`triangulate_robust`]); above it, views are left out one at a
+/// time.
+const MAX_EXHAUSTIVE_VIEWS: usize = 8;
+
+/// Triangulates from every view; when the mean reprojection error is above
+/// `max_error` pixels, tries every subset of the views, the largest first,
+/// and keeps the subset of the most views that meets `max_error`, the one
+/// with the smallest error among those (Pose2Sim tries leaving out cameras
+/// the same way). A view that drags the first estimate off is thus judged
+/// against the others, not against a point it has already pulled toward
+/// itself. Sightings of zero weight never take part. `None` when fewer
+/// than `min_views` (at least 2) views are left or they do not meet; when
+/// no subset meets `max_error`, the subset of `min_views` views that fits
+/// best.
 pub fn triangulate_robust(
     cameras: &[Camera],
     sightings: &[Sighting],
@@ -125,35 +135,82 @@ pub fn triangulate_robust(
     min_views: usize,
 ) -> Option<Triangulated> {
     let min_views = min_views.max(2);
-    let mut used: Vec<usize> = (0..sightings.len())
+    let views: Vec<usize> = (0..sightings.len())
         .filter(|&i| sightings[i].weight > 0.0)
         .collect();
-    let mut subset: Vec<Sighting> = Vec::with_capacity(used.len());
-    loop {
-        if used.len() < min_views {
-            return None;
-        }
+    if views.len() < min_views {
+        return None;
+    }
+    let mut subset: Vec<Sighting> = Vec::with_capacity(views.len());
+    let mut fit = |used: &[usize]| -> Option<Triangulated> {
         subset.clear();
         subset.extend(used.iter().map(|&i| sightings[i]));
         let point = triangulate(cameras, &subset)?;
-        let errors: Vec<f64> = subset
+        let error = subset
             .iter()
             .map(|s| reprojection_error(cameras, s, point))
-            .collect();
-        let error = errors.iter().sum::<f64>() / errors.len() as f64;
-        if error <= max_error {
-            return Some(Triangulated { point, error, used });
+            .sum::<f64>()
+            / subset.len() as f64;
+        // Behind one of its views: no point at all.
+        error.is_finite().then(|| Triangulated {
+            point,
+            error,
+            used: used.to_vec(),
+        })
+    };
+    let all = fit(&views);
+    if all.as_ref().is_some_and(|t| t.error <= max_error) || views.len() == min_views {
+        return all;
+    }
+    if views.len() > MAX_EXHAUSTIVE_VIEWS {
+        return leave_out_one_at_a_time(views, fit, max_error, min_views);
+    }
+    let mut best_of_size: Option<Triangulated> = None;
+    for size in (min_views..views.len()).rev() {
+        best_of_size = None;
+        for mask in 0u32..(1 << views.len()) {
+            if mask.count_ones() as usize != size {
+                continue;
+            }
+            let used: Vec<usize> = (0..views.len())
+                .filter(|b| mask & (1 << b) != 0)
+                .map(|b| views[b])
+                .collect();
+            if let Some(t) = fit(&used) {
+                if best_of_size.as_ref().is_none_or(|b| t.error < b.error) {
+                    best_of_size = Some(t);
+                }
+            }
         }
-        if used.len() == min_views {
-            // Views that still disagree: the point behind one of them is
-            // no point at all.
-            return error
-                .is_finite()
-                .then_some(Triangulated { point, error, used });
+        if best_of_size.as_ref().is_some_and(|t| t.error <= max_error) {
+            return best_of_size;
         }
-        let worst = (0..errors.len())
-            .max_by(|&a, &b| errors[a].total_cmp(&errors[b]))
-            .expect("at least two views");
+    }
+    best_of_size
+}
+
+/// For many views: leaves out the view that fits worst, one at a time,
+/// while the mean error is above `max_error`.
+fn leave_out_one_at_a_time(
+    mut used: Vec<usize>,
+    mut fit: impl FnMut(&[usize]) -> Option<Triangulated>,
+    max_error: f64,
+    min_views: usize,
+) -> Option<Triangulated> {
+    loop {
+        let t = fit(&used)?;
+        if t.error <= max_error || used.len() == min_views {
+            return Some(t);
+        }
+        // Each view's own error decides which goes: fit without each, keep
+        // the best.
+        let (worst, _) = (0..used.len())
+            .filter_map(|k| {
+                let mut without = used.clone();
+                without.remove(k);
+                Some((k, fit(&without)?.error))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
         used.remove(worst);
     }
 }
@@ -270,5 +327,19 @@ mod tests {
             reprojection_error(&cameras, &views[1], robust.point).round(),
             80.0
         );
+    }
+
+    #[test]
+    fn two_views_that_disagree_of_four_are_both_left_out() {
+        let cameras = four_cameras();
+        let point = DVec3::new(-0.1, 0.3, 0.9);
+        let mut views = seen(&cameras, point, 1.0);
+        for (k, shift) in [(0, DVec2::new(60.0, -30.0)), (2, DVec2::new(-45.0, 70.0))] {
+            views[k].pixel += shift;
+            views[k].normalized = cameras[k].undistort(views[k].pixel);
+        }
+        let robust = triangulate_robust(&cameras, &views, 5.0, 2).unwrap();
+        assert_eq!(robust.used, vec![1, 3]);
+        assert!(robust.point.distance(point) < 1e-9);
     }
 }
