@@ -38,6 +38,9 @@ pub struct CaptureOptions {
     pub fps: Option<f64>,
     /// How many people to write (the ones found in the most frames).
     pub people: usize,
+    /// Hold each BVH's planted feet still and above the floor
+    /// (mocap-feet) before it is written.
+    pub feet: Option<mocap_feet::FeetOptions>,
     pub triangulation: TriangulationOptions,
     pub association: AssociationOptions,
 }
@@ -50,6 +53,7 @@ impl CaptureOptions {
             layout: None,
             fps: None,
             people: 1,
+            feet: None,
             triangulation: TriangulationOptions::default(),
             association: AssociationOptions::default(),
         }
@@ -550,6 +554,8 @@ pub struct PersonReport {
     /// Bone-length spread (mm) of [`SPREAD_BONES`] and their mean.
     pub bone_spread_mm: Vec<Option<f64>>,
     pub mean_bone_spread_mm: Option<f64>,
+    /// What the feet stage did, when asked for.
+    pub feet: Option<mocap_feet::FeetReport>,
 }
 
 /// What `mocap cameras run` did.
@@ -634,6 +640,7 @@ pub fn run_capture(options: &CaptureOptions, output: &Path) -> Result<CaptureRep
         if i == 0 {
             trial.notes.push(up_note);
         }
+        let (motion, feet) = mocap_feet::plant_feet_if_asked(motion, options.feet.as_ref())?;
         let path = person_output(output, i);
         mocap_core::io::bvh::write_bvh(&path, &motion)?;
         let keypoints = keypoint_reports(trial.layout, &person.frames);
@@ -665,6 +672,7 @@ pub fn run_capture(options: &CaptureOptions, output: &Path) -> Result<CaptureRep
             reprojection_px: (!all.is_empty()).then(|| all.iter().sum::<f64>() / all.len() as f64),
             mean_bone_spread_mm: mean_of(&spread),
             bone_spread_mm: spread,
+            feet,
         });
     }
     Ok(CaptureReport {

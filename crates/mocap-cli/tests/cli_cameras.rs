@@ -55,6 +55,22 @@ fn a_simulated_trial_is_triangulated_written_as_bvh_and_evaluated() {
     let source = mocap_core::io::bvh::read_bvh(&walk).unwrap();
     assert_eq!(motion.frame_count(), source.frame_count());
     assert!((motion.fps() - source.fps()).abs() < 1e-3);
+    // With the feet stage: the report says what it did.
+    let planted = dir.path().join("walk-feet.bvh");
+    let out = mocap(&[
+        "cameras",
+        "run",
+        path(&trial),
+        "-o",
+        path(&planted),
+        "--feet",
+        "--json",
+    ]);
+    ok(&out);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let feet = &report["people"][0]["feet"];
+    assert!(feet["feet"][0]["contacts"].as_u64().unwrap() >= 2, "{feet}");
+    assert!(report["people"][0]["feet"].is_object() && person["feet"].is_null());
     // The BVH is a rig the rest of the pipeline knows.
     let info = mocap(&["info", path(&bvh)]);
     ok(&info);

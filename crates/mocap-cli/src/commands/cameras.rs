@@ -10,7 +10,7 @@ use mocap_cameras::{
     CameraSimOptions, CaptureOptions, Layout, Method, TriangulationOptions,
 };
 
-use super::args::ReportArgs;
+use super::args::{FeetArgs, ReportArgs};
 use super::GlobalOptions;
 
 #[derive(clap::Args)]
@@ -106,6 +106,8 @@ struct RunArgs {
     /// How many people to write, the ones found in the most frames first.
     #[arg(long, default_value_t = 1)]
     people: usize,
+    #[command(flatten)]
+    feet: FeetArgs,
     /// Print the report as JSON on standard output.
     #[arg(long)]
     json: bool,
@@ -123,6 +125,7 @@ fn run_trial(args: RunArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         return Err(anyhow!("--people must be at least 1"));
     }
     capture.people = args.people;
+    capture.feet = args.feet.options();
     let report = run_capture(&capture, &args.output)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -150,6 +153,9 @@ fn run_trial(args: RunArgs, options: &GlobalOptions) -> anyhow::Result<()> {
             person.reprojection_px.unwrap_or(f64::NAN),
             person.mean_bone_spread_mm.unwrap_or(f64::NAN)
         );
+        if let Some(feet) = &person.feet {
+            eprintln!("  {}", super::feet::summary(feet));
+        }
         let worst = person
             .keypoints
             .iter()
