@@ -18,10 +18,10 @@ use mocap_fuse::{BodyModel, BvhOptions, JOINT_COUNT};
 use crate::associate::{follow, people_in_frame, AssociationOptions, Track};
 use crate::camera::{read_calibration, Camera, CameraRig};
 use crate::keypoints::{find_camera_folders, read_openpose_folder, CameraKeypoints, Person2d};
-use crate::kinect::kinect_pose;
+use crate::kinect::{kinect_pose, REQUIRED};
 use crate::layout::Layout;
 use crate::solve::{
-    measure_person, triangulate_frame, Frame3d, Method, PersonModel, TriangulationOptions,
+    measure_person, measure_person_by_scores, triangulate_take, Frame3d, TriangulationOptions,
 };
 
 /// What `mocap cameras run` is asked to do.
@@ -216,15 +216,12 @@ pub fn read_trial(options: &CaptureOptions) -> Result<Trial> {
     if configured.is_none() {
         notes.push(format!("layout {} told from the keypoints", layout.label()));
     }
-    for (camera, calibrated) in cameras.iter().zip(&rig.cameras) {
-        if camera.missing_files > 0 {
-            notes.push(format!(
-                "{}: {} frame files missing, taken as frames with nobody",
-                camera.folder.display(),
-                camera.missing_files
-            ));
-        }
-        let _ = calibrated;
+    for camera in cameras.iter().filter(|c| c.missing_files > 0) {
+        notes.push(format!(
+            "{}: {} frame files missing, taken as frames with nobody",
+            camera.folder.display(),
+            camera.missing_files
+        ));
     }
     let first_frame = cameras.iter().map(|c| c.first_frame).min().unwrap_or(0);
     let end = cameras
@@ -316,8 +313,8 @@ pub struct Person3d {
 }
 
 /// Triangulates the people of a trial (the `people` found in the most
-/// frames): a first pass by score measures each person's body, the second
-/// uses `options.method`.
+/// frames) with `options.method`; for the methods that need the person's
+/// bones, a first pass by score measures them.
 pub fn triangulate_trial(
     trial: &Trial,
     people: usize,
@@ -330,25 +327,19 @@ pub fn triangulate_trial(
         .iter()
         .take(people)
         .map(|track| {
-            let by_score = TriangulationOptions {
-                method: Method::Scores,
-                ..*options
-            };
-            let pass = |o: &TriangulationOptions, person: Option<&PersonModel>| -> Vec<Frame3d> {
-                (0..trial.frames)
-                    .map(|f| {
-                        let seen = detections(trial, track, f);
-                        triangulate_frame(cameras, trial.layout, &seen, person, o)
-                    })
-                    .collect()
-            };
-            let first = pass(&by_score, None);
-            let person = measure_person(trial.layout, &first);
-            let frames = pass(options, Some(&person));
-            Person3d {
-                frames,
-                body: person.body,
-            }
+            let seen: Vec<Vec<Option<&Person2d>>> = (0..trial.frames)
+                .map(|f| detections(trial, track, f))
+                .collect();
+            let person = options
+                .method
+                .needs_person()
+                .then(|| measure_person_by_scores(cameras, trial.layout, &seen, options));
+            let frames = triangulate_take(cameras, trial.layout, &seen, person.as_ref(), options);
+            // The fitter takes bone lengths from the frames themselves; the
+            // body is measured from them when no first pass was needed.
+            let body =
+                person.map_or_else(|| measure_person(trial.layout, &frames).body, |p| p.body);
+            Person3d { frames, body }
         })
         .collect()
 }
@@ -442,23 +433,11 @@ pub fn person_motion(
     for (f, frame) in filled.iter().enumerate() {
         let turned: Vec<Option<DVec3>> = frame.iter().map(|p| p.map(|p| rotation * p)).collect();
         let pose = kinect_pose(layout, &turned).ok_or_else(|| {
-            let missing: Vec<&str> = [
-                "LShoulder",
-                "RShoulder",
-                "LElbow",
-                "RElbow",
-                "LWrist",
-                "RWrist",
-                "LHip",
-                "RHip",
-                "LKnee",
-                "RKnee",
-                "LAnkle",
-                "RAnkle",
-            ]
-            .into_iter()
-            .filter(|n| layout.index_of(n).and_then(|i| turned[i]).is_none())
-            .collect();
+            let missing: Vec<&str> = REQUIRED
+                .iter()
+                .map(|(_, name)| *name)
+                .filter(|n| layout.index_of(n).and_then(|i| turned[i]).is_none())
+                .collect();
             Error::Invalid(format!(
                 "frame {f}: no BVH can be fitted: {} never triangulated in the whole trial \
                  (seen by fewer than two cameras)",

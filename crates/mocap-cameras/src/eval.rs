@@ -12,7 +12,7 @@ use mocap_core::{Error, Result};
 
 use crate::capture::{bone_spread, mean_of, read_trial, tracks, CaptureOptions, Trial};
 use crate::keypoints::Person2d;
-use crate::solve::{measure_person, triangulate_frame, Frame3d, Method, TriangulationOptions};
+use crate::solve::{measure_person_by_scores, triangulate_take, Method, TriangulationOptions};
 use crate::trc::{read_trc, trc_to_zup, Markers};
 
 /// What to compare with.
@@ -144,26 +144,13 @@ pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
         p.is_finite().then_some(p)
     };
     let base = options.capture.triangulation;
-    let first = {
-        let o = TriangulationOptions {
-            method: Method::Scores,
-            ..base
-        };
-        let frames: Vec<Frame3d> = detections
-            .iter()
-            .map(|d| triangulate_frame(&trial.rig.cameras, trial.layout, d, None, &o))
-            .collect();
-        frames
-    };
-    let person = measure_person(trial.layout, &first);
+    let cameras = &trial.rig.cameras;
+    let person = measure_person_by_scores(cameras, trial.layout, &detections, &base);
     let mut methods = Vec::new();
     for method in Method::ALL {
         let o = TriangulationOptions { method, ..base };
         let start = Instant::now();
-        let frames: Vec<Frame3d> = detections
-            .iter()
-            .map(|d| triangulate_frame(&trial.rig.cameras, trial.layout, d, Some(&person), &o))
-            .collect();
+        let frames = triangulate_take(cameras, trial.layout, &detections, Some(&person), &o);
         let seconds = start.elapsed().as_secs_f64();
         let at = |f: usize, k: usize| Some(frames[f].get(k).copied().flatten()?.position);
         let seen: Vec<f64> = frames.iter().flatten().flatten().map(|k| k.error).collect();

@@ -62,28 +62,32 @@ pub(crate) struct KinectPose {
     pub seen: [bool; JOINT_COUNT],
 }
 
+/// The limb keypoints the fitter cannot do without, and their Kinect
+/// joints (besides something of the head).
+pub(crate) const REQUIRED: [(usize, &str); 12] = [
+    (SHOULDER_LEFT, "LShoulder"),
+    (ELBOW_LEFT, "LElbow"),
+    (WRIST_LEFT, "LWrist"),
+    (SHOULDER_RIGHT, "RShoulder"),
+    (ELBOW_RIGHT, "RElbow"),
+    (WRIST_RIGHT, "RWrist"),
+    (HIP_LEFT, "LHip"),
+    (KNEE_LEFT, "LKnee"),
+    (ANKLE_LEFT, "LAnkle"),
+    (HIP_RIGHT, "RHip"),
+    (KNEE_RIGHT, "RKnee"),
+    (ANKLE_RIGHT, "RAnkle"),
+];
+
 /// The Kinect pose of one frame's keypoints (in `layout`'s order), or `None`
-/// when a joint the fitter cannot do without (hips, shoulders, elbows,
-/// wrists, knees, ankles, something of the head) is missing.
+/// when a keypoint of [`REQUIRED`] or every keypoint of the head is
+/// missing.
 pub(crate) fn kinect_pose(layout: Layout, points: &[Option<DVec3>]) -> Option<KinectPose> {
     let get = |name: &str| layout.index_of(name).and_then(|i| points.get(i).copied()?);
     let mid = |a: &str, b: &str| Some(0.5 * (get(a)? + get(b)?));
     let mut joints = [DVec3::ZERO; JOINT_COUNT];
     let mut seen = [true; JOINT_COUNT];
-    for (joint, name) in [
-        (SHOULDER_LEFT, "LShoulder"),
-        (ELBOW_LEFT, "LElbow"),
-        (WRIST_LEFT, "LWrist"),
-        (SHOULDER_RIGHT, "RShoulder"),
-        (ELBOW_RIGHT, "RElbow"),
-        (WRIST_RIGHT, "RWrist"),
-        (HIP_LEFT, "LHip"),
-        (KNEE_LEFT, "LKnee"),
-        (ANKLE_LEFT, "LAnkle"),
-        (HIP_RIGHT, "RHip"),
-        (KNEE_RIGHT, "RKnee"),
-        (ANKLE_RIGHT, "RAnkle"),
-    ] {
+    for (joint, name) in REQUIRED {
         joints[joint] = get(name)?;
     }
     joints[SPINE_BASE] = get("MidHip").unwrap_or(0.5 * (joints[HIP_LEFT] + joints[HIP_RIGHT]));

@@ -63,8 +63,8 @@ pub use sim::{
     SimulationReport,
 };
 pub use solve::{
-    measure_person, triangulate_frame, Frame3d, Keypoint3d, Method, PersonModel,
-    TriangulationOptions,
+    measure_person, measure_person_by_scores, triangulate_frame, triangulate_take, Frame3d,
+    Keypoint3d, Method, PersonModel, TriangulationOptions,
 };
 pub use trc::{read_trc, trc_to_zup, write_trc, zup_to_trc, Markers};
 pub use triangulate::{

@@ -74,6 +74,12 @@ impl Method {
         }
     }
 
+    /// Whether the method's confidence needs the person measured
+    /// beforehand ([`measure_person_by_scores`]).
+    pub fn needs_person(self) -> bool {
+        self >= Method::BoneLength
+    }
+
     pub fn parse(text: &str) -> Option<Method> {
         Method::ALL.into_iter().find(|m| m.label() == text)
     }
@@ -95,9 +101,8 @@ impl Method {
             // own, so a pair's wrong elbow says nothing of its wrist (a depth
             // sensor's tracker fits the wrist to the elbow, which is why the
             // report propagates). Propagated, the terms of a whole arm
-            // multiply and the wrist's weights turn to noise: the robust
-            // method's MPJPE 14.2 mm propagated, 12.8 not, on the simulated
-            // walk (docs/research/cameras.md).
+            // multiply and the wrist's weights turn to noise
+            // (docs/research/cameras.md).
             propagate: false,
             ..ConfidenceModel::default()
         };
@@ -294,6 +299,39 @@ pub fn triangulate_frame(
             })
         })
         .collect()
+}
+
+/// Triangulates every frame of one person: `detections[f][c]` is the
+/// person camera `c` saw at frame `f` ([`triangulate_frame`]).
+pub fn triangulate_take(
+    cameras: &[Camera],
+    layout: Layout,
+    detections: &[Vec<Option<&Person2d>>],
+    person: Option<&PersonModel>,
+    options: &TriangulationOptions,
+) -> Vec<Frame3d> {
+    detections
+        .iter()
+        .map(|seen| triangulate_frame(cameras, layout, seen, person, options))
+        .collect()
+}
+
+/// The person measured on a first pass triangulated by score alone, for
+/// the methods whose confidence needs the person's bones.
+pub fn measure_person_by_scores(
+    cameras: &[Camera],
+    layout: Layout,
+    detections: &[Vec<Option<&Person2d>>],
+    options: &TriangulationOptions,
+) -> PersonModel {
+    let by_score = TriangulationOptions {
+        method: Method::Scores,
+        ..*options
+    };
+    measure_person(
+        layout,
+        &triangulate_take(cameras, layout, detections, None, &by_score),
+    )
 }
 
 /// What the confidence needs to know of the person.

@@ -330,6 +330,29 @@ mod tests {
     }
 
     #[test]
+    fn with_many_views_the_one_that_disagrees_is_left_out_one_at_a_time() {
+        // Nine cameras: more than the subset search takes on.
+        let target = DVec3::new(0.0, 0.0, 1.0);
+        let cameras: Vec<Camera> = (0..=MAX_EXHAUSTIVE_VIEWS)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / (MAX_EXHAUSTIVE_VIEWS + 1) as f64;
+                looking_at(
+                    &format!("cam{i}"),
+                    DVec3::new(3.0 * a.cos(), 3.0 * a.sin(), 1.5),
+                    target,
+                )
+            })
+            .collect();
+        let point = DVec3::new(0.2, -0.1, 1.1);
+        let mut views = seen(&cameras, point, 1.0);
+        views[4].pixel += DVec2::new(200.0, -150.0);
+        views[4].normalized = cameras[4].undistort(views[4].pixel);
+        let robust = triangulate_robust(&cameras, &views, 5.0, 2).unwrap();
+        assert_eq!(robust.used, vec![0, 1, 2, 3, 5, 6, 7, 8]);
+        assert!(robust.point.distance(point) < 1e-9);
+    }
+
+    #[test]
     fn two_views_that_disagree_of_four_are_both_left_out() {
         let cameras = four_cameras();
         let point = DVec3::new(-0.1, 0.3, 0.9);

@@ -125,6 +125,7 @@ fn bad_command_lines_and_inputs_are_named() {
         "best",
     ]);
     assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--method \"best\": expected plain"));
     // An empty folder: no calibration to be found.
     let out = mocap(&["cameras", "run", path(dir.path()), "-o", "x.bvh"]);
     assert_eq!(out.status.code(), Some(1));
