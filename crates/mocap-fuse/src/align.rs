@@ -658,6 +658,8 @@ pub struct BodySensorReport {
     /// Standard deviations of the fitted rotation (degrees) and translation
     /// (metres) when the 25 joints are drawn again with replacement
     /// ([`joint_bootstrap`]): what the joints' own biases leave uncertain.
+    /// They, like `yaw_uncertainty_degrees`, describe the fit to the
+    /// reference, before the consensus refinement (`refined`).
     pub rotation_uncertainty_degrees: f64,
     pub translation_uncertainty: f64,
     /// Whether the consensus refinement replaced the first fit (`pairs`,
@@ -910,7 +912,9 @@ pub fn calibrate_from_body(
             mirrored_won,
             &transform,
             options.inlier_distance,
-            &mut rng,
+            // Its own draws: a figure of the report must not change the
+            // RANSAC draws of the sensors after this one.
+            &mut StdRng::seed_from_u64(options.seed ^ (u64::from(sensor) << 32)),
         );
         let yaw_uncertainty_degrees = {
             let inlier2 = options.inlier_distance * options.inlier_distance;

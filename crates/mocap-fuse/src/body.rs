@@ -415,6 +415,18 @@ pub fn percentile(samples: &mut [f32], q: f32) -> f32 {
     samples[i.min(samples.len() - 1)]
 }
 
+/// The median of `values` (the mean of the middle two for an even count),
+/// sorting them; `None` for none.
+pub(crate) fn median(values: &mut [f64]) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(values[n / 2]),
+        _ => Some(0.5 * (values[n / 2 - 1] + values[n / 2])),
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

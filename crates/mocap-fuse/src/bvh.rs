@@ -451,20 +451,28 @@ pub fn fused_to_motion_with(
     options: &BvhOptions,
     lengths: BoneLengthSource,
 ) -> Result<Motion> {
-    if !(options.fps.is_finite() && options.fps > 0.0) {
-        return Err(Error::Invalid(format!(
-            "BVH frame rate must be positive, got {}",
-            options.fps
-        )));
-    }
-    if !(options.units_per_metre.is_finite() && options.units_per_metre > 0.0) {
-        return Err(Error::Invalid(format!(
-            "units per metre must be positive, got {}",
-            options.units_per_metre
-        )));
-    }
+    options.check()?;
     let poses = regular_poses(frames, options.fps);
     poses_to_motion_with(&poses, body, options, lengths)
+}
+
+impl BvhOptions {
+    /// A positive frame rate and unit, or an error saying which is not.
+    pub fn check(&self) -> Result<()> {
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(Error::Invalid(format!(
+                "BVH frame rate must be positive, got {}",
+                self.fps
+            )));
+        }
+        if !(self.units_per_metre.is_finite() && self.units_per_metre > 0.0) {
+            return Err(Error::Invalid(format!(
+                "units per metre must be positive, got {}",
+                self.units_per_metre
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// Joint positions (metres, Kinect order, one array per frame at

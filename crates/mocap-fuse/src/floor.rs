@@ -200,8 +200,7 @@ fn planted_contacts(poses: &[[Vec3; JOINT_COUNT]], up: Vec3) -> Vec<Contact> {
 }
 
 fn median(values: &mut [f32]) -> f32 {
-    values.sort_by(f32::total_cmp);
-    values[values.len() / 2]
+    crate::body::percentile(values, 0.5)
 }
 
 /// The kept contacts' centroid per kind (`None` for a kind with none).

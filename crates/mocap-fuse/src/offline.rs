@@ -333,7 +333,9 @@ pub struct PelvisDistance {
 pub struct SensorAgreement {
     pub sensor: u16,
     /// Per frame with a pelvis seen here and by another sensor at that
-    /// instant: the distance to the nearest other sensor's pelvis.
+    /// instant: the distance to the nearest other sensor's pelvis. Left
+    /// out of the JSON reports (one entry a frame), which give the median.
+    #[serde(skip)]
     pub per_frame: Vec<PelvisDistance>,
     /// Their median (`None`: no frame to compare).
     pub median_distance: Option<f64>,
@@ -442,15 +444,7 @@ pub fn check_same_person(
                 })
                 .collect();
             let mut distances: Vec<f64> = per_frame.iter().map(|d| d.distance).collect();
-            distances.sort_by(f64::total_cmp);
-            let median_distance = (!distances.is_empty()).then(|| {
-                let n = distances.len();
-                if n % 2 == 1 {
-                    distances[n / 2]
-                } else {
-                    0.5 * (distances[n / 2 - 1] + distances[n / 2])
-                }
-            });
+            let median_distance = crate::body::median(&mut distances);
             SensorAgreement {
                 sensor,
                 per_frame,

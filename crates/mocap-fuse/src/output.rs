@@ -23,9 +23,9 @@ use serde::Serialize;
 
 use crate::body::BodyModel;
 use crate::bvh::{
-    fit_error, fused_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError,
+    fit_error, poses_to_motion_with, regular_poses, BoneLengthSource, BvhOptions, FitError,
 };
-use crate::floor::{fit_floor, floor_transform, BvhWorld, FloorReport};
+use crate::floor::{fit_floor, stand_on_floor, BvhWorld, FloorReport};
 use crate::fusion::FusedFrame;
 
 /// Where fused frames go.
@@ -278,19 +278,18 @@ impl FrameSink for FusedOutputs {
                 "no fused frames: nothing to write to the BVH output".into(),
             ));
         }
-        let fps = self.bvh_options.fps;
+        self.bvh_options.check()?;
+        // The fused frames on the BVH's grid, once: stood on the floor,
+        // fitted, and what the written file is measured against.
+        let mut poses = regular_poses(&self.frames, self.bvh_options.fps);
         let floor = match self.world {
-            // An unusable rate is refused by the BVH's fit below.
-            BvhWorld::Floor if fps.is_finite() && fps > 0.0 => {
-                stand_frames_on_floor(&mut self.frames, fps)
-            }
-            _ => None,
+            BvhWorld::Floor => fit_floor(&poses)
+                .map(|floor| FloorReport::new(floor, stand_on_floor(&mut poses, &floor))),
+            BvhWorld::Calibration => None,
         };
-        let motion =
-            fused_to_motion_with(&self.frames, &self.body, &self.bvh_options, self.lengths)?;
+        let motion = poses_to_motion_with(&poses, &self.body, &self.bvh_options, self.lengths)?;
         let (motion, feet) = plant_feet_if_asked(motion, self.feet.as_ref())
             .map_err(|e| Error::Invalid(format!("--feet, on the fused take: {e}")))?;
-        let poses = regular_poses(&self.frames, self.bvh_options.fps);
         for path in std::mem::take(&mut self.bvh) {
             mocap_core::io::bvh::write_bvh(&path, &motion)?;
             let back = mocap_core::io::bvh::read_bvh(&path)?;
@@ -306,20 +305,4 @@ impl FrameSink for FusedOutputs {
         }
         Ok(())
     }
-}
-
-/// Stands the fused frames on the floor under their feet ([`fit_floor`] on
-/// the frames as the BVH puts them on its grid of `fps`,
-/// [`floor_transform`]), in place; `None` (frames left as they are) when no
-/// floor is found.
-fn stand_frames_on_floor(frames: &mut [FusedFrame], fps: f64) -> Option<FloorReport> {
-    let poses = regular_poses(frames, fps);
-    let floor = fit_floor(&poses)?;
-    let transform = floor_transform(&poses, &floor);
-    for frame in frames.iter_mut() {
-        for p in frame.joints.iter_mut() {
-            *p = transform.apply(*p);
-        }
-    }
-    Some(FloorReport::new(floor, transform))
 }

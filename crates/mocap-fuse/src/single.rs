@@ -26,10 +26,6 @@ use crate::recording::{read_any_recording, JointObservation, SensorFrame};
 /// writes its BVH.
 const UNITS_PER_METRE: f32 = 100.0;
 
-/// The frame rate of Kinect v2 body tracking: the grid of a recording of a
-/// single frame, which has no time step of its own.
-const KINECT_FPS: f64 = 30.0;
-
 /// The skeleton one depth sensor recorded, as a motion on the fitted Kinect
 /// v2 skeleton (joint names `SpineBase`, `HipLeft`...; the body map finds it
 /// as "Kinect v2"), in centimetres (100 units per metre).
@@ -168,16 +164,7 @@ fn time_step(frames: &[SensorFrame]) -> f64 {
         .map(|w| w[1].timestamp - w[0].timestamp)
         .filter(|d| *d > 0.0)
         .collect();
-    if steps.is_empty() {
-        return 1.0 / KINECT_FPS;
-    }
-    steps.sort_by(f64::total_cmp);
-    let mid = steps.len() / 2;
-    if steps.len() % 2 == 1 {
-        steps[mid]
-    } else {
-        0.5 * (steps[mid - 1] + steps[mid])
-    }
+    crate::body::median(&mut steps).unwrap_or(1.0 / crate::recording::NTU_FPS)
 }
 
 /// Each frame's 25 positions (metres, camera space) with every NotTracked

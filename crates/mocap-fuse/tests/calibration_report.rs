@@ -8,70 +8,67 @@ use mocap_fuse::{
 
 #[test]
 fn the_report_holds_the_files_figures_and_an_uncertainty_the_truth_respects() {
-    let dir = tempfile::tempdir().unwrap();
-    let options = SimulationOptions {
-        sensors: 3,
-        seed: 5,
-        ..Default::default()
-    };
-    let sim = simulate_to_folder(
-        &mocap_testdata::sample_walk(),
-        dir.path(),
-        &options,
-        None,
-        false,
-    )
-    .unwrap();
-    let output = dir.path().join("body.calib.toml");
-    let report = calibrate_recordings(
-        &sim.files.recordings,
-        &BodyCalibrationOptions::default(),
-        &output,
-    )
-    .unwrap();
-    let written = Calibration::read(&output).unwrap();
-    let truth = Calibration::read(&sim.files.calibration).unwrap();
-    let world = *truth.get(report.reference).unwrap();
-    assert_eq!(report.sensors.len(), 2);
-    for s in &report.sensors {
-        let pose = written.sensors.iter().find(|p| p.id == s.sensor).unwrap();
-        // The printed figures are the file's, refined or not.
-        assert_eq!(pose.pairs, Some(s.inliers), "sensor {}", s.sensor);
-        assert_eq!(pose.rms_residual, Some(s.rms), "sensor {}", s.sensor);
-        assert!(s.inliers <= s.pairs);
-        // The uncertainty is an honest size: the true error is within a
-        // few standard deviations of it, plus what the simulated sensors'
-        // shared biases move every joint by (which no resampling sees).
-        let true_pose = world.inverse().then_after(truth.get(s.sensor).unwrap());
-        let angle = pose
-            .transform
-            .rotation
-            .angle_between(true_pose.rotation)
-            .to_degrees() as f64;
-        let shift = (pose.transform.translation - true_pose.translation).length() as f64;
-        eprintln!(
-            "sensor {}: off by {angle:.2} deg, {:.1} cm; reported +-{:.2} deg, +-{:.1} cm",
-            s.sensor,
-            shift * 100.0,
-            s.rotation_uncertainty_degrees,
-            s.translation_uncertainty * 100.0
-        );
-        assert!(
-            (0.005..5.0).contains(&s.rotation_uncertainty_degrees),
-            "{}",
-            s.rotation_uncertainty_degrees
-        );
-        assert!(
-            (0.0005..0.2).contains(&s.translation_uncertainty),
-            "{}",
-            s.translation_uncertainty
-        );
-        assert!(
-            angle < 4.0 * s.rotation_uncertainty_degrees + 2.0,
-            "{angle}"
-        );
-        assert!(shift < 4.0 * s.translation_uncertainty + 0.1, "{shift}");
+    // Over four simulated captures of the walk, the true error of each
+    // calibrated sensor, in units of its reported uncertainty.
+    let mut ratios = Vec::new();
+    for seed in 5..=8u64 {
+        let dir = tempfile::tempdir().unwrap();
+        let options = SimulationOptions {
+            sensors: 3,
+            seed,
+            ..Default::default()
+        };
+        let sim = simulate_to_folder(
+            &mocap_testdata::sample_walk(),
+            dir.path(),
+            &options,
+            None,
+            false,
+        )
+        .unwrap();
+        let output = dir.path().join("body.calib.toml");
+        let report = calibrate_recordings(
+            &sim.files.recordings,
+            &BodyCalibrationOptions::default(),
+            &output,
+        )
+        .unwrap();
+        let written = Calibration::read(&output).unwrap();
+        let truth = Calibration::read(&sim.files.calibration).unwrap();
+        let world = *truth.get(report.reference).unwrap();
+        assert_eq!(report.sensors.len(), 2);
+        for s in &report.sensors {
+            let pose = written.sensors.iter().find(|p| p.id == s.sensor).unwrap();
+            // The printed figures are the file's, refined or not.
+            assert_eq!(pose.pairs, Some(s.inliers), "sensor {}", s.sensor);
+            assert_eq!(pose.rms_residual, Some(s.rms), "sensor {}", s.sensor);
+            assert!(s.inliers <= s.pairs);
+            let true_pose = world.inverse().then_after(truth.get(s.sensor).unwrap());
+            let angle = pose
+                .transform
+                .rotation
+                .angle_between(true_pose.rotation)
+                .to_degrees() as f64;
+            let shift = (pose.transform.translation - true_pose.translation).length() as f64;
+            eprintln!(
+                "seed {seed} sensor {}: off by {angle:.2} deg, {:.1} cm; reported +-{:.2} deg, +-{:.1} cm",
+                s.sensor,
+                shift * 100.0,
+                s.rotation_uncertainty_degrees,
+                s.translation_uncertainty * 100.0
+            );
+            ratios.push(angle / s.rotation_uncertainty_degrees);
+            ratios.push(shift / s.translation_uncertainty);
+        }
     }
+    // An honest standard deviation: the truth within a few of them, and
+    // not always far inside one (an uncertainty ten times too large, or
+    // ten times too small, fails).
+    let worst = ratios.iter().copied().fold(0.0, f64::max);
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    eprintln!("true error / reported uncertainty: mean {mean:.2}, worst {worst:.2}");
+    assert!(worst < 5.0, "{ratios:?}");
+    assert!(mean > 0.3, "{ratios:?}");
 }
 
 #[test]
