@@ -16,7 +16,7 @@ use mocap_core::{Error, Motion, Result};
 use mocap_fuse::{BodyModel, BvhOptions, JOINT_COUNT};
 
 use crate::associate::{follow, people_in_frame, AssociationOptions, Track};
-use crate::camera::{read_calibration, Camera, CameraRig};
+use crate::camera::{read_calibration, Camera, CameraRig, Format};
 use crate::keypoints::{find_camera_folders, read_openpose_folder, CameraKeypoints, Person2d};
 use crate::kinect::{kinect_pose, REQUIRED};
 use crate::layout::Layout;
@@ -134,12 +134,7 @@ fn find_calibration(trial: &Path) -> Result<PathBuf> {
                 .map_err(|e| Error::io(&folder, e))?
                 .flatten()
                 .map(|e| e.path())
-                .filter(|p| {
-                    matches!(
-                        p.extension().and_then(|e| e.to_str()),
-                        Some("toml" | "yml" | "yaml" | "json")
-                    )
-                })
+                .filter(|p| Format::of(p).is_ok())
                 .collect();
             files.sort();
             if let Some(file) = files.into_iter().next() {

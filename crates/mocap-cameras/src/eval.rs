@@ -132,16 +132,39 @@ pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
     let detections: Vec<Vec<Option<&Person2d>>> = (0..trial.frames)
         .map(|f| crate::capture::detections(&trial, track, f))
         .collect();
+    // The markers in the layout's order, looked up by name once.
+    let in_layout_order = |m: Markers| -> Vec<Vec<Option<DVec3>>> {
+        let index: Vec<Option<usize>> = names
+            .iter()
+            .map(|name| m.names.iter().position(|n| n == name))
+            .collect();
+        m.positions
+            .iter()
+            .map(|row| {
+                index
+                    .iter()
+                    .map(|i| row.get((*i)?).copied().filter(|p| p.is_finite()))
+                    .collect()
+            })
+            .collect()
+    };
     let truth = options.truth.as_deref().map(markers_in_world).transpose()?;
-    let reference = options
+    let reference_markers = options
         .reference
         .as_deref()
         .map(markers_in_world)
         .transpose()?;
-    let marker = |m: &Markers, f: usize, name: &str| -> Option<DVec3> {
-        let i = m.names.iter().position(|n| n == name)?;
-        let p = *m.positions.get(f)?.get(i)?;
-        p.is_finite().then_some(p)
+    let matched: Vec<String> = reference_markers.as_ref().map_or_else(Vec::new, |r| {
+        names
+            .iter()
+            .filter(|n| r.names.iter().any(|m| m == *n))
+            .map(|n| n.to_string())
+            .collect()
+    });
+    let truth = truth.map(in_layout_order);
+    let reference = reference_markers.map(in_layout_order);
+    let marker = |m: &[Vec<Option<DVec3>>], f: usize, k: usize| -> Option<DVec3> {
+        m.get(f)?.get(k).copied().flatten()
     };
     let base = options.capture.triangulation;
     let cameras = &trial.rig.cameras;
@@ -162,7 +185,7 @@ pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
             for (k, name) in names.iter().enumerate() {
                 let (mut s, mut c) = (0.0, 0usize);
                 for f in 0..frames.len() {
-                    let Some(t) = marker(truth, f, name) else {
+                    let Some(t) = marker(truth, f, k) else {
                         continue;
                     };
                     total += 1;
@@ -187,9 +210,8 @@ pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
         let to_reference = reference.as_ref().and_then(|r| {
             let d: Vec<f64> = (0..frames.len())
                 .flat_map(|f| {
-                    names.iter().enumerate().filter_map(move |(k, name)| {
-                        Some(at(f, k)?.distance(marker(r, f, name)?) * 1000.0)
-                    })
+                    (0..names.len())
+                        .filter_map(move |k| Some(at(f, k)?.distance(marker(r, f, k)?) * 1000.0))
                 })
                 .collect();
             (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
@@ -209,18 +231,15 @@ pub fn evaluate_trial(options: &CameraEvalOptions) -> Result<CameraEvalReport> {
     }
     let reference_result = match (&reference, &options.reference) {
         (Some(r), Some(path)) => {
-            let matched: Vec<String> = names
-                .iter()
-                .filter(|n| r.names.iter().any(|m| m == *n))
-                .map(|n| n.to_string())
-                .collect();
-            let spread = bone_spread(trial.frames, |f, name| marker(r, f, name));
+            let spread = bone_spread(trial.frames, |f, name| {
+                marker(r, f, trial.layout.index_of(name)?)
+            });
             Some(ReferenceResult {
                 path: path.clone(),
                 reprojection_all_px: reprojection_all(
                     &trial,
                     &detections,
-                    |f, k| marker(r, f, names[k]),
+                    |f, k| marker(r, f, k),
                     base.min_score,
                 ),
                 bone_spread_mm: mean_of(&spread),

@@ -200,27 +200,6 @@ const BODY_25B: [&str; 25] = [
     "RHeel",     // 24
 ];
 
-/// The COCO keypoints.
-const COCO_17: [&str; 17] = [
-    "Nose",      // 0
-    "LEye",      // 1
-    "REye",      // 2
-    "LEar",      // 3
-    "REar",      // 4
-    "LShoulder", // 5
-    "RShoulder", // 6
-    "LElbow",    // 7
-    "RElbow",    // 8
-    "LWrist",    // 9
-    "RWrist",    // 10
-    "LHip",      // 11
-    "RHip",      // 12
-    "LKnee",     // 13
-    "RKnee",     // 14
-    "LAnkle",    // 15
-    "RAnkle",    // 16
-];
-
 /// Halpe-FullBody's body: COCO's 17, then head, neck, hip (our `MidHip`) and
 /// the feet, left and right interleaved (unlike BODY_25B).
 const HALPE_26: [&str; 26] = [
@@ -308,7 +287,8 @@ impl Layout {
         match self {
             Layout::Body25 => &BODY_25,
             Layout::Body25B => &BODY_25B,
-            Layout::Coco17 => &COCO_17,
+            // The first 17 of BODY_25B.
+            Layout::Coco17 => &BODY_25B[..17],
             Layout::Halpe26 => &HALPE_26,
             Layout::BlazePose33 => &BLAZEPOSE_33,
         }

@@ -39,8 +39,8 @@ pub struct Markers {
 
 /// The most coordinates (frames × markers × 3) a header may announce: a
 /// header that asks for more is refused before anything is allocated. 50
-/// million values are an hour of 100 markers at 60 Hz, four times the largest
-/// real capture we know of.
+/// million values are more than an hour of 100 markers at 60 Hz (21.6
+/// million).
 const MAX_VALUES: usize = 50_000_000;
 
 /// A point of a Pose2Sim TRC file (Y up) in the Z-up world of its
@@ -543,6 +543,7 @@ mod tests {
             v.sort_by(f64::total_cmp);
             v[v.len() / 2]
         };
+        let mut pooled = Vec::new();
         for (c, camera) in rig.cameras.iter().enumerate() {
             let folder = trial.join(format!("pose-associated/cam{:02}_json", c + 1));
             let views = crate::keypoints::read_openpose_folder(&folder, Some(layout)).unwrap();
@@ -572,10 +573,17 @@ mod tests {
                 }
             }
             assert!(turned.len() > 50, "{}", turned.len());
+            pooled.extend_from_slice(&turned);
             let (turned, raw) = (median(turned), median(raw));
-            assert!(turned < 25.0, "camera {c}: {turned} px turned");
+            eprintln!("camera {c}: median {turned:.1} px");
+            // Measured on every tenth frame: 7.3-17.1 px per camera (cam_03,
+            // the highest, has a few right joints 50 px off that Pose2Sim
+            // left out of its triangulation).
+            assert!(turned < 20.0, "camera {c}: {turned} px turned");
             assert!(raw > 300.0, "camera {c}: {raw} px as read");
         }
+        let pooled = median(pooled);
+        assert!(pooled < 12.0, "all cameras: {pooled} px");
     }
 
     #[test]
