@@ -955,7 +955,10 @@ mod tests {
     #[test]
     fn the_error_rates_come_out_as_asked() {
         let motion = walk();
-        let near = |measured: f64, asked: f64| (measured - asked).abs() < 0.5 * asked;
+        // Measured with this seed: misses 2.83%, outliers 2.10%, swaps 9.6%:
+        // within a fifth of what was asked (a binomial's spread over these
+        // counts is 4-11% of the rate).
+        let near = |measured: f64, asked: f64| (measured - asked).abs() < 0.2 * asked;
 
         // Misses: visible keypoints reported undetected.
         let options = CameraSimOptions {
@@ -1056,9 +1059,9 @@ mod tests {
             }
         }
         let share = rate(hidden.len(), hidden.len() + seen.len());
-        // About 3% with the default cameras on the bundled walk: mostly the
-        // far shoulder and the far arm seen from the side.
-        assert!((0.01..0.35).contains(&share), "occluded share {share}");
+        // 3.2% measured with the default cameras on the bundled walk:
+        // mostly the far shoulder and the far arm seen from the side.
+        assert!((0.02..0.05).contains(&share), "occluded share {share}");
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
         // Mean distance of a 2D Gaussian of s.d. σ per axis: σ √(π/2).
         let expected = 2.5 * (std::f64::consts::PI / 2.0).sqrt();
