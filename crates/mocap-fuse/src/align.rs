@@ -859,7 +859,8 @@ pub fn calibrate_from_body(
         if sensor == reference {
             continue;
         }
-        let period = 1.0 / 30.0;
+        // Pairs are made on the reference's clock, at its own frame rate.
+        let period = crate::offline::frame_period(ref_frames);
         let mut paired_frames = 0;
         let mut settled: Vec<(Joints, Joints)> = Vec::new();
         let mut as_labelled: Vec<(Joints, Joints)> = Vec::new();
@@ -996,7 +997,6 @@ fn refine_by_consensus(
             .flat_map(|s| s.iter().map(|f| &f.joints)),
         crate::body::MeasureOptions::default(),
     );
-    let period = 1.0 / 30.0;
     let inlier2 = options.inlier_distance * options.inlier_distance;
     let ids: Vec<u16> = streams.streams.keys().copied().collect();
     for &sensor in ids.iter().filter(|&&s| s != reference) {
@@ -1015,6 +1015,8 @@ fn refine_by_consensus(
             crate::fusion::Fuser::new(crate::fusion::FusionOptions::best(), body.clone());
         let tracked = |a: &JointObservation| a.state == TrackingState::Tracked;
         let (mut src, mut dst) = (Vec::new(), Vec::new());
+        // The others are sampled at this sensor's instants, at its rate.
+        let period = crate::offline::frame_period(&streams.streams[&sensor]);
         for f in &streams.streams[&sensor] {
             let views = crate::offline::views_at(&others, calibration, f.timestamp, period);
             let Some(fused) = fuser.fuse(f.timestamp, &views) else {

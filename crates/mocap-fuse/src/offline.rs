@@ -112,6 +112,19 @@ impl SensorStreams {
 /// sensor's clock says, far above the rounding of a time written as text.
 pub const SAME_INSTANT: f64 = 0.01;
 
+/// A stream's frame period (s): the median step between its frames' times,
+/// so that a recording at 15 or 60 frames per second is paired at its own
+/// rate; 1/30 s (Kinect v2) for a stream of fewer than two frames. Gaps
+/// (dropped frames) are rare enough not to move the median.
+pub fn frame_period(frames: &[SensorFrame]) -> f64 {
+    let mut steps: Vec<f64> = frames
+        .windows(2)
+        .map(|w| w[1].timestamp - w[0].timestamp)
+        .filter(|d| *d > 0.0 && d.is_finite())
+        .collect();
+    crate::body::median(&mut steps).unwrap_or(1.0 / 30.0)
+}
+
 /// A sensor's skeleton at instant `t` (camera space), interpolated between
 /// its frames; `None` when it has no frame close enough. A frame within
 /// [`SAME_INSTANT`] of a period of `t` gives its own tracking states;

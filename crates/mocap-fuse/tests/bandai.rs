@@ -136,3 +136,54 @@ fn a_take_as_the_capture_stage_makes_it_pairs_with_its_truth_frame_for_frame() {
     .unwrap();
     assert!(off > cm, "{off} against {cm}");
 }
+
+#[test]
+fn sensors_at_ten_frames_a_second_calibrate_from_the_body_at_their_own_rate() {
+    // Every third frame of a 30 fps simulation: frames 100 ms apart. Paired
+    // at a fixed 1/30 s, frames between two of the reference's were too far
+    // from both (gaps over 2.5 periods); at the recording's own period every
+    // frame pairs, and the calibration comes out.
+    let motion = mocap_core::io::bvh::read_bvh(&mocap_testdata::sample_walk()).unwrap();
+    let mut truth = truth_from_motion(&motion, None).unwrap();
+    center_truth(&mut truth, Some(2.0));
+    let sim = simulate(
+        &truth,
+        &SimulationOptions {
+            sensors: 3,
+            seed: 4,
+            ..Default::default()
+        },
+    );
+    // The sensors' clocks are half a frame apart, so that pairs are made
+    // between frames, not at shared instants.
+    let streams = SensorStreams::new(sim.sensors.iter().enumerate().flat_map(|(k, s)| {
+        s.frames.iter().step_by(3).map(move |f| {
+            let mut f = f.clone();
+            f.timestamp += 0.05 * k as f64;
+            f
+        })
+    }));
+    let found = calibrate_from_body(&streams, &Default::default()).unwrap();
+    // Every frame pairs with the reference (at 1/30 s, only half did).
+    let frames = sim.sensors[0].frames.len().div_ceil(3);
+    for report in &found.sensors {
+        assert!(
+            report.paired_frames + 2 >= frames,
+            "sensor {}: {} of {frames} frames paired",
+            report.sensor,
+            report.paired_frames
+        );
+    }
+    let world_from_reference = sim.sensors[found.reference as usize].pose;
+    for s in &found.calibration.sensors {
+        let truth = world_from_reference
+            .inverse()
+            .then_after(&sim.sensors[s.id as usize].pose);
+        let angle = s
+            .transform
+            .rotation
+            .angle_between(truth.rotation)
+            .to_degrees();
+        assert!(angle < 10.0, "sensor {}: {angle} degrees", s.id);
+    }
+}
