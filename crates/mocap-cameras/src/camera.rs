@@ -117,15 +117,18 @@ impl Camera {
         let distorted = self.remove_intrinsics(pixel);
         let mut point = distorted;
         for _ in 0..UNDISTORT_STEPS {
+            // One evaluation of the model per step serves both the test
+            // (does the estimate distort back to the pixel?) and the update.
             let r2 = point.length_squared();
             let radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
             if radial.is_nan() || radial <= 0.0 {
                 return distorted;
             }
-            point = (distorted - tangential(point, p1, p2)) / radial;
-            if (self.distort(point) - distorted).length() < UNDISTORT_TOLERANCE {
+            let shift = tangential(point, p1, p2);
+            if (point * radial + shift - distorted).length() < UNDISTORT_TOLERANCE {
                 break;
             }
+            point = (distorted - shift) / radial;
         }
         point
     }
@@ -638,19 +641,8 @@ fn toml_node(value: &toml::de::DeValue<'_>, at: (usize, usize), lines: &Lines) -
 }
 
 fn read_json(text: &str, path: &Path) -> Result<Vec<Camera>> {
-    let root: Node = serde_json::from_str(text).map_err(|e| {
-        // serde_json's message ends with its own " at line L column C".
-        let message = e.to_string();
-        let message = message
-            .rfind(" at line ")
-            .map_or(message.as_str(), |end| &message[..end]);
-        Error::parse(
-            path,
-            e.line().max(1),
-            e.column().max(1),
-            format!("not valid JSON: {message}"),
-        )
-    })?;
+    let root: Node = serde_json::from_str(text)
+        .map_err(|e| crate::keypoints::json_error(path, &e, "not valid JSON: "))?;
     let cameras = match root.get("cameras") {
         Some(cameras) => cameras,
         None => &root,

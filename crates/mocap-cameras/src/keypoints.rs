@@ -386,20 +386,25 @@ fn read_frame(path: &Path, expect: &Expect) -> Result<ViewFrame> {
     FrameSeed(expect)
         .deserialize(&mut deserializer)
         .and_then(|frame| deserializer.end().map(|()| frame))
-        .map_err(|e| json_error(path, &e))
+        .map_err(|e| json_error(path, &e, ""))
 }
 
-/// A serde_json error as a parse error at its line and column.
-fn json_error(path: &Path, error: &serde_json::Error) -> Error {
+/// A serde_json error as a parse error at its line and column, its message
+/// after `prefix` (for the calibration's JSON reader too).
+pub(crate) fn json_error(path: &Path, error: &serde_json::Error, prefix: &str) -> Error {
     let (line, column) = (error.line(), error.column());
     // serde_json's message ends with " at line L column C"; the location is
     // given apart.
     let message = error.to_string();
     let message = message
         .strip_suffix(&format!(" at line {line} column {column}"))
-        .unwrap_or(&message)
-        .to_string();
-    Error::parse(path, line.max(1), column.max(1), message)
+        .unwrap_or(&message);
+    Error::parse(
+        path,
+        line.max(1),
+        column.max(1),
+        format!("{prefix}{message}"),
+    )
 }
 
 /// The keypoint count every person must have: the layout's, else the count

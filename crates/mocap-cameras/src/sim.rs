@@ -324,22 +324,29 @@ fn body_25_truth(
         .collect();
     let mean_pelvis = joints.iter().map(|j| j[SPINE_BASE]).sum::<DVec3>() / frames.max(1) as f64;
     let shift = DVec3::new(mean_pelvis.x, mean_pelvis.y, 0.0);
-    joints
-        .iter()
-        .map(|j| {
-            let j = j.map(|p| p - shift);
-            let points = body_25_points(&j);
+    // The points come in one fixed order: each of the layout's names is
+    // looked up once, not at every frame.
+    let order: Vec<usize> = match joints.first() {
+        Some(j) => {
+            let points = body_25_points(j);
             layout
                 .names()
                 .iter()
                 .map(|name| {
                     points
                         .iter()
-                        .find(|(n, _)| n == name)
-                        .map(|&(_, p)| p)
+                        .position(|(n, _)| n == name)
                         .expect("every BODY_25 keypoint is defined")
                 })
                 .collect()
+        }
+        None => Vec::new(),
+    };
+    joints
+        .iter()
+        .map(|j| {
+            let points = body_25_points(&j.map(|p| p - shift));
+            order.iter().map(|&k| points[k].1).collect()
         })
         .collect()
 }

@@ -1422,9 +1422,11 @@ fn estimated_offsets(
         return Vec::new();
     }
     let mut reports = Vec::new();
+    // The reference's shapes, once for every camera compared with it.
+    let reference_shapes = shape_features(&frames_of[reference], fps);
     for &k in untimed.iter().filter(|&&k| k != reference) {
-        let estimate =
-            estimate_time_offset(&frames_of[reference], &frames_of[k], fps, MAX_OFFSET_FRAMES);
+        let shapes = shape_features(&frames_of[k], fps);
+        let estimate = offset_between_shapes(&reference_shapes, &shapes, MAX_OFFSET_FRAMES);
         let applied = estimate
             .as_ref()
             .is_some_and(|e| e.correlation >= min_correlation);
@@ -1510,8 +1512,18 @@ pub fn estimate_time_offset(
     fps: f64,
     max_lag: usize,
 ) -> Option<OffsetEstimate> {
-    let a = shape_features(reference, fps);
-    let b = shape_features(other, fps);
+    offset_between_shapes(
+        &shape_features(reference, fps),
+        &shape_features(other, fps),
+        max_lag,
+    )
+}
+
+/// Frame shapes by frame number ([`shape_features`]).
+type Shapes = std::collections::BTreeMap<i64, Vec<f64>>;
+
+/// [`estimate_time_offset`] on the two recordings' shapes.
+fn offset_between_shapes(a: &Shapes, b: &Shapes, max_lag: usize) -> Option<OffsetEstimate> {
     let max_lag = max_lag as i64;
     // Correlations over few frames are noisy, and the noisier the likelier
     // to be the highest: a lag counts only where the two share at least two
@@ -1519,7 +1531,7 @@ pub fn estimate_time_offset(
     // 11 frames matched better than the true 0).
     let min_pairs = (2 * a.len().min(b.len())).div_ceil(3);
     let scores: Vec<(i64, f64, usize)> = (-max_lag..=max_lag)
-        .filter_map(|lag| shape_correlation(&a, &b, lag).map(|(r, n)| (lag, r, n)))
+        .filter_map(|lag| shape_correlation(a, b, lag).map(|(r, n)| (lag, r, n)))
         .filter(|&(_, _, n)| n >= min_pairs)
         .collect();
     // The peaks: lags better than both neighbours. A maximum at the edge of
@@ -1556,7 +1568,7 @@ pub fn estimate_time_offset(
 /// Each frame's shape by frame number `round(t * fps)`: the distance of
 /// every pair of joints averaged with its mirror image (each such class
 /// once), NaN where a joint is NotTracked.
-fn shape_features(frames: &[SensorFrame], fps: f64) -> std::collections::BTreeMap<i64, Vec<f64>> {
+fn shape_features(frames: &[SensorFrame], fps: f64) -> Shapes {
     use crate::kinect::MIRROR;
     let classes: Vec<((usize, usize), (usize, usize))> = (0..JOINT_COUNT)
         .flat_map(|i| ((i + 1)..JOINT_COUNT).map(move |j| (i, j)))
@@ -1596,11 +1608,7 @@ fn shape_features(frames: &[SensorFrame], fps: f64) -> std::collections::BTreeMa
 /// The correlation of two shape series with `b` `lag` frames later (all
 /// distances at once, each centred on its own mean over the frames
 /// compared) and how many frames were compared; `None` under 10.
-fn shape_correlation(
-    a: &std::collections::BTreeMap<i64, Vec<f64>>,
-    b: &std::collections::BTreeMap<i64, Vec<f64>>,
-    lag: i64,
-) -> Option<(f64, usize)> {
+fn shape_correlation(a: &Shapes, b: &Shapes, lag: i64) -> Option<(f64, usize)> {
     #[derive(Clone, Copy, Default)]
     struct Sums {
         n: usize,
