@@ -47,10 +47,31 @@ fn a_folder_of_ntu_files_is_evaluated_with_the_body_or_a_given_calibration() {
             std::fs::copy(entry.path(), ntu.join(entry.file_name())).unwrap();
         }
     }
-    let body = ok(&mocap(&["fuse", "eval", path(&ntu), "--json"]));
+    let plots = dir.path().join("plots");
+    let body = ok(&mocap(&[
+        "fuse",
+        "eval",
+        path(&ntu),
+        "--json",
+        "--plots",
+        path(&plots),
+    ]));
     let take = &body[0];
     assert_eq!(take["sensors"].as_array().unwrap().len(), 3, "{body}");
     assert_eq!(take["calibration"].as_array().unwrap().len(), 2, "{body}");
+    // A filmstrip a person can judge: a row per sensor and the fused one
+    // (panels are 320 pixels high).
+    let strips: Vec<_> = std::fs::read_dir(&plots).unwrap().flatten().collect();
+    assert_eq!(strips.len(), 1, "{strips:?}");
+    let name = strips[0].file_name().to_string_lossy().into_owned();
+    assert!(
+        name.starts_with("filmstrip-S") && name.ends_with(".png"),
+        "{name}"
+    );
+    let png = std::fs::read(strips[0].path()).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert!((4 * 320..5 * 320).contains(&height), "{height} pixels high");
 
     // Calibrated once, then evaluated with that file.
     let files: Vec<String> = std::fs::read_dir(&ntu)

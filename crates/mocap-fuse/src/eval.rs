@@ -915,6 +915,69 @@ pub struct ConsistencyReport {
     /// file placed the sensors).
     pub calibration: Vec<crate::align::BodySensorReport>,
     pub rows: Vec<ConsistencyRow>,
+    /// Each sensor's skeletons and the fused ones (best version), in the
+    /// world on the fused clock: what a filmstrip of the take shows (`mocap
+    /// fuse eval --plots`), for a person to judge what the figures say. Not
+    /// in the JSON report.
+    #[serde(skip)]
+    pub poses: Vec<SourcePoses>,
+}
+
+/// One source's skeletons over a take ([`ConsistencyReport::poses`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourcePoses {
+    /// "sensor 2", "fused (best)".
+    pub source: String,
+    /// Seconds between frames (the fused clock's).
+    pub frame_time: f64,
+    /// World positions (metres), Kinect v2 order, frame after frame.
+    pub joints: Vec<[Vec3; JOINT_COUNT]>,
+    /// How far each joint is to be trusted, 0 to 1: a sensor's tracking
+    /// state (Tracked 1, Inferred 0.5, NotTracked or no frame near 0), the
+    /// fused confidence capped at 1.
+    pub confidence: Vec<[f32; JOINT_COUNT]>,
+}
+
+/// A sensor's skeletons at the fused frames' `times`, in the world; frames
+/// where the sensor has none near hold its nearest skeleton, at confidence
+/// 0. `None` for a sensor without a pose or a frame near any instant.
+fn sensor_poses_at(
+    sensor: u16,
+    frames: &[crate::recording::SensorFrame],
+    calibration: &Calibration,
+    times: &[f64],
+    frame_time: f64,
+) -> Option<SourcePoses> {
+    use crate::kinect::TrackingState;
+    let pose = calibration.get(sensor)?;
+    let period = crate::offline::frame_period(frames);
+    let sampled: Vec<Option<[crate::recording::JointObservation; JOINT_COUNT]>> = times
+        .iter()
+        .map(|&t| crate::offline::sample_stream(frames, t, period))
+        .collect();
+    let first = sampled.iter().flatten().next()?;
+    let (mut joints, mut confidence) = (Vec::new(), Vec::new());
+    let mut held = *first;
+    for sample in &sampled {
+        match sample {
+            Some(observed) => {
+                held = *observed;
+                confidence.push(observed.map(|j| match j.state {
+                    TrackingState::Tracked => 1.0,
+                    TrackingState::Inferred => 0.5,
+                    TrackingState::NotTracked => 0.0,
+                }));
+            }
+            None => confidence.push([0.0; JOINT_COUNT]),
+        }
+        joints.push(held.map(|j| pose.apply(j.position)));
+    }
+    Some(SourcePoses {
+        source: format!("sensor {sensor}"),
+        frame_time,
+        joints,
+        confidence,
+    })
 }
 
 fn consistency_row(
@@ -1028,17 +1091,36 @@ pub fn evaluate_consistency(
             &body,
         ));
     }
+    let mut shown = Vec::new();
     for (name, options) in methods {
         let mut fuser = Fuser::new(*options, body.clone());
         let fused = fuse_streams(&streams, &calibration, &mut fuser, fps, None);
         let poses: Vec<[Vec3; JOINT_COUNT]> = fused.iter().map(|f| f.joints).collect();
         rows.push(consistency_row(name.clone(), &poses, &|_, _| true, &body));
+        // The last method (the best version) is the one shown.
+        shown = vec![SourcePoses {
+            source: name.clone(),
+            frame_time: 1.0 / fps,
+            joints: poses,
+            confidence: fused
+                .iter()
+                .map(|f| f.confidence.map(|c| c.min(1.0)))
+                .collect(),
+        }];
+        let times: Vec<f64> = fused.iter().map(|f| f.time).collect();
+        shown.splice(
+            0..0,
+            streams.streams.iter().filter_map(|(&sensor, frames)| {
+                sensor_poses_at(sensor, frames, &calibration, &times, 1.0 / fps)
+            }),
+        );
     }
     Ok(ConsistencyReport {
         take: take.to_string(),
         sensors: streams.streams.keys().copied().collect(),
         calibration: calibration_report,
         rows,
+        poses: shown,
     })
 }
 

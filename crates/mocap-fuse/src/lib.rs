@@ -144,7 +144,7 @@ pub use eval::{
     consistency_markdown, evaluate, evaluate_consistency, evaluate_inputs, evaluate_recordings,
     evaluate_with, group_takes, report_markdown, simulated_fused_take, CalibrationError,
     CalibrationSource, ConsistencyReport, ConsistencyRow, EvalOptions, EvalReport, Evaluation,
-    MethodResult, PerJointChart, PerJointSeries, CONSISTENCY_BONES,
+    MethodResult, PerJointChart, PerJointSeries, SourcePoses, CONSISTENCY_BONES,
 };
 pub use floor::{
     fit_floor, floor_transform, stand_on_floor, BvhWorld, Floor, FloorMethod, FloorReport,

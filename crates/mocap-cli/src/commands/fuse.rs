@@ -689,7 +689,7 @@ struct EvalArgs {
     /// Also run methods with joint ranges from this ASF skeleton's limits (BVH).
     #[arg(long, value_name = "SKELETON.asf")]
     limits: Option<PathBuf>,
-    /// Draw per-joint position errors (BVH) here: `per-joint-<K>-sensors.png` and `.svg`.
+    /// Draw here: per-joint position errors (BVH: `per-joint-<K>-sensors.png`, `.svg`), or a filmstrip of each take of recordings (`filmstrip-<take>.png`: each sensor and the fused skeleton).
     #[arg(long, value_name = "DIR")]
     plots: Option<PathBuf>,
     #[command(flatten)]
@@ -719,8 +719,12 @@ fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         progress.set_position(done as u64);
     })?;
     progress.finish_and_clear();
-    if let (Some(dir), Evaluation::Truth(report)) = (&args.plots, &evaluation) {
-        draw_per_joint_charts(&report.per_joint_charts(), dir)?;
+    match (&args.plots, &evaluation) {
+        (Some(dir), Evaluation::Truth(report)) => {
+            draw_per_joint_charts(&report.per_joint_charts(), dir)?
+        }
+        (Some(dir), Evaluation::Consistency(reports)) => draw_filmstrips(reports, dir, options)?,
+        (None, _) => {}
     }
     let markdown = evaluation.markdown(&command);
     if let Some(path) = &args.report.markdown {
@@ -732,6 +736,62 @@ fn eval(args: EvalArgs, options: &GlobalOptions) -> anyhow::Result<()> {
         println!("{markdown}");
         Ok(())
     }
+}
+
+/// Draws each take of recordings as `filmstrip-<take>.png` in `dir`: a row
+/// per sensor (in the world, by its calibration) and one for the fused
+/// skeleton, at the same moments, joints coloured by confidence.
+fn draw_filmstrips(
+    reports: &[mocap_fuse::ConsistencyReport],
+    dir: &Path,
+    options: &GlobalOptions,
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let names: Vec<String> = mocap_fuse::JOINT_NAMES
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    for report in reports {
+        let motions = report
+            .poses
+            .iter()
+            .map(|poses| {
+                mocap_view::ViewMotion::from_positions(
+                    poses.source.clone(),
+                    names.clone(),
+                    mocap_fuse::PARENTS.to_vec(),
+                    poses.frame_time,
+                    poses.joints.iter().flatten().copied().collect(),
+                    Some(1.0),
+                )?
+                .with_confidence(poses.confidence.iter().flatten().copied().collect())
+            })
+            .collect::<mocap_core::Result<Vec<_>>>()?;
+        let take: String = Path::new(&report.take)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| report.take.clone())
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '-'
+                }
+            })
+            .collect();
+        let path = dir.join(format!("filmstrip-{take}.png"));
+        let render = mocap_view::RenderOptions {
+            layout: mocap_view::Layout::Rows,
+            ..Default::default()
+        };
+        mocap_view::render(&mocap_view::Scene::new(motions), &path, &render)
+            .with_context(|| format!("drawing {}", path.display()))?;
+        if !options.quiet {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
 }
 
 /// Draws each chart as `per-joint-<K>-sensors.png` and `.svg` in `dir`.
