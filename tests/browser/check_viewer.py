@@ -13,7 +13,7 @@ python3-selenium), and checks what a person would:
 - hovering a joint names it;
 - a screenshot is not blank: the motions' colours are on it.
 
-Usage: check_viewer.py --viewer PATH_TO_MOCAP_BINARY [--out DIR] FILE.bvh...
+Usage: check_viewer.py --viewer PATH_TO_MOCAP_BINARY [--out DIR] FILE.bvh|FILE.glb...
 Prints one line per check and "N passed, N failed"; exits 1 on a failure.
 """
 
@@ -134,9 +134,24 @@ def hex_rgb(colour):
 
 # ---------- what the files say ----------
 
+def gltf_counts(path):
+    """(frames, joints) of a glTF or GLB file, from its JSON: the sample
+    count of the first animation's time accessor, and the first skin's
+    joints."""
+    data = open(path, "rb").read()
+    if data[:4] == b"glTF":
+        length = struct.unpack_from("<I", data, 12)[0]
+        data = data[20:20 + length]
+    document = json.loads(data.decode("utf-8"))
+    sampler = document["animations"][0]["samplers"][0]
+    return document["accessors"][sampler["input"]]["count"], len(document["skins"][0]["joints"])
+
+
 def file_counts(path):
-    """(frames, joints) as written in a BVH file's text, or in a fused
-    capture (.jsonl, one frame per line)."""
+    """(frames, joints) as written in a BVH file's text, in a fused
+    capture (.jsonl, one frame per line) or in a glTF file's JSON."""
+    if path.endswith((".glb", ".gltf")):
+        return gltf_counts(path)
     text = open(path, encoding="utf-8", errors="replace").read()
     if path.endswith(".jsonl"):
         lines = [json.loads(line) for line in text.splitlines() if line.strip()]

@@ -2,7 +2,8 @@
 # Browser test of `mocap view` (the mocap-view crate's viewer) in a real
 # headless Chromium (run as `mocap view`): installs Debian's chromium and chromium-driver when they
 # are missing, builds the viewer, and runs check_viewer.py on the bundled
-# sample, a second Bandai take when the shared data is there, and a small
+# sample (as BVH and as the .glb `mocap convert` writes), a second Bandai
+# take when the shared data is there, and a small
 # synthetic fused capture with confidence (written by the script).
 #
 #   bash tests/browser/run.sh            # from anywhere in the repository
@@ -37,6 +38,10 @@ else
 fi
 
 OUT_DIR="${OUT:-$TARGET_DIR/browser-test}"
+mkdir -p "$OUT_DIR"
+# The bundled sample as glTF (mocap convert), played from the .glb.
+"$VIEWER" convert --quiet samples/dataset-1_walk_normal_001.bvh "$OUT_DIR/sample.glb"
+FILES+=("$OUT_DIR/sample.glb")
 echo "== headless Chromium"
 "$PYTHON" tests/browser/check_viewer.py --viewer "$VIEWER" --out "$OUT_DIR" --with-fused \
     --chromium "$(command -v chromium)" --chromedriver "$(command -v chromedriver)" "${FILES[@]}"

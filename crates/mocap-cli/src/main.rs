@@ -33,7 +33,7 @@ struct Cli {
 enum Command {
     /// Joints, channels, frames, frame rate, duration and bounding box of motion files.
     Info(commands::info::Args),
-    /// Convert, trim, resample, mirror or rescale a motion and write it as BVH.
+    /// Convert, trim, resample, mirror or rescale a motion and write it as BVH or glTF.
     Convert(commands::convert::Args),
     /// Global joint positions of every frame, as CSV or JSON.
     Positions(commands::positions::Args),
@@ -87,6 +87,8 @@ fn main() -> ExitCode {
     }
     // Sensor recordings (.skeleton, .jsonl) read as motions by every command.
     mocap_fuse::register_recording_readers();
+    // glTF (.glb, .gltf) read by every command and written by `convert`.
+    mocap_gltf::register_formats();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(args, &options),
         Command::Convert(args) => commands::convert::run(args, &options),

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use mocap_core::convert::{convert_files, ConvertOptions};
-use mocap_core::io::write_motion;
+use mocap_core::io::write_motion_noted;
 use mocap_core::ops::FrameRange;
 
 use super::GlobalOptions;
@@ -12,11 +12,13 @@ use super::GlobalOptions;
 #[derive(clap::Args)]
 #[command(
     after_help = "Steps run in this order: join inputs, --frames, --fps, --mirror, --scale, --retarget-to.\n\
-Examples:\n  mocap convert walk.bvh --fps 30 walk30.bvh\n  mocap convert HDM_bd.asf HDM_bd_walk.amc walk.bvh\n  mocap convert take.bvh --frames 100..400 --mirror clip.bvh\n  mocap convert cmu_walk.bvh --retarget-to mixamo_character.bvh walk_on_mixamo.bvh"
+The output's extension picks its format: .bvh, or .glb/.gltf (glTF 2.0: a skinned body in metres, Y up).\n\
+Examples:\n  mocap convert walk.bvh --fps 30 walk30.bvh\n  mocap convert walk.bvh walk.glb\n  mocap convert character.glb character.bvh\n  mocap convert HDM_bd.asf HDM_bd_walk.amc walk.bvh\n  mocap convert take.bvh --frames 100..400 --mirror clip.bvh\n  mocap convert cmu_walk.bvh --retarget-to mixamo_character.bvh walk_on_mixamo.bvh"
 )]
 pub struct Args {
-    /// Inputs then the output: `IN.bvh OUT.bvh`, `X.asf X.amc OUT.bvh`, or several
-    /// BVH takes of one skeleton (joined in order) then OUT.bvh.
+    /// Inputs then the output: `IN OUT`, `X.asf X.amc OUT`, or several takes of one
+    /// skeleton (joined in order) then OUT. Inputs: BVH, ASF/AMC, glTF (.glb, .gltf) and
+    /// sensor recordings; OUT: .bvh, .glb or .gltf.
     #[arg(required = true, num_args = 1.., action = clap::ArgAction::Append)]
     paths: Vec<PathBuf>,
     /// Resample to this many frames per second (slerp on rotations).
@@ -53,8 +55,12 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
     let motion = convert_files(inputs, &convert)?;
     let read: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     options.note_if_replacing_an_input(&read, output);
-    write_motion(output, &motion)?;
+    let notes = write_motion_noted(output, &motion)?;
     if !options.quiet {
+        // What the writer changed on the way (glTF's units and axes).
+        for note in &notes {
+            eprintln!("note: {note}");
+        }
         eprintln!(
             "wrote {} ({} frames at {:.3} fps, {} joints)",
             output.display(),

@@ -10,6 +10,8 @@
 //! capability's own, such as mocap-fuse's sensor recordings) join them
 //! through [`register_reader`]: every later [`read_motion`],
 //! [`read_motions`] and [`MotionSource::group`] in the process reads them.
+//! [`write_motion`] picks the writer the same way, and a format's crate
+//! joins it through [`register_writer`] (mocap-gltf's `.glb` and `.gltf`).
 
 pub mod asf_amc;
 pub mod atomic;
@@ -34,20 +36,88 @@ pub enum MotionSource {
     Registered(PathBuf),
 }
 
-/// A reader given to the whole process ([`register_reader`]).
-struct RegisteredReader {
+/// Reads a motion file of a format given with [`register_reader`].
+pub type ReadFn = fn(&Path) -> Result<Motion>;
+
+/// Writes a motion file of a format given with [`register_writer`] and
+/// returns notes for the person who asked: what the writer changed on the
+/// way (lengths scaled to the format's units, axes turned), so that a
+/// converter can say so. A writer that changes nothing returns none.
+pub type WriteFn = fn(&Path, &Motion) -> Result<Vec<String>>;
+
+/// A format given to the whole process by another crate: the extensions it
+/// is chosen by, what it is, and the function that reads or writes it.
+struct Registered<F> {
     /// Lower-case extensions, without the dot.
     extensions: Vec<String>,
     describe: &'static str,
-    read: fn(&Path) -> Result<Motion>,
+    run: F,
 }
 
 /// Readers of the formats the core does not know, in the order they were
 /// given ([`register_reader`]).
-static REGISTERED_READERS: RwLock<Vec<RegisteredReader>> = RwLock::new(Vec::new());
+static REGISTERED_READERS: RwLock<Vec<Registered<ReadFn>>> = RwLock::new(Vec::new());
+
+/// Writers of the formats the core does not know ([`register_writer`]).
+static REGISTERED_WRITERS: RwLock<Vec<Registered<WriteFn>>> = RwLock::new(Vec::new());
 
 /// Built-in extensions: [`register_reader`] cannot take them over.
 const BUILT_IN: [&str; 3] = ["bvh", "asf", "amc"];
+
+/// Built-in extensions: [`register_writer`] cannot take them over.
+const BUILT_IN_WRITTEN: [&str; 1] = ["bvh"];
+
+/// Adds `run` for `extensions` (those in `built_in` left out) to `registry`:
+/// the one rule of [`register_reader`] and [`register_writer`].
+fn register<F>(
+    registry: &RwLock<Vec<Registered<F>>>,
+    built_in: &[&str],
+    extensions: &[&'static str],
+    describe: &'static str,
+    run: F,
+) {
+    let extensions: Vec<String> = extensions
+        .iter()
+        .map(|e| e.trim_start_matches('.').to_ascii_lowercase())
+        .filter(|e| !e.is_empty() && !built_in.contains(&e.as_str()))
+        .collect();
+    if extensions.is_empty() {
+        return;
+    }
+    let mut formats = registry.write().unwrap_or_else(|e| e.into_inner());
+    // A later registration takes its extensions over from earlier ones.
+    for format in formats.iter_mut() {
+        format.extensions.retain(|e| !extensions.contains(e));
+    }
+    formats.retain(|r| !r.extensions.is_empty());
+    formats.push(Registered {
+        extensions,
+        describe,
+        run,
+    });
+}
+
+/// The function registered in `registry` for the lower-case `extension`.
+fn registered<F: Copy>(registry: &RwLock<Vec<Registered<F>>>, extension: &str) -> Option<F> {
+    registry
+        .read()
+        .unwrap_or_else(|e| e.into_inner())
+        .iter()
+        .find(|r| r.extensions.iter().any(|e| e == extension))
+        .map(|r| r.run)
+}
+
+/// The formats of `registry` for an error message: `, or .a or .b (what
+/// they are)` for each.
+fn registered_types<F>(registry: &RwLock<Vec<Registered<F>>>) -> String {
+    let formats = registry.read().unwrap_or_else(|e| e.into_inner());
+    let mut types = String::new();
+    for format in formats.iter() {
+        let extensions: Vec<String> = format.extensions.iter().map(|e| format!(".{e}")).collect();
+        types += &format!(", or {} ({})", extensions.join(" or "), format.describe);
+    }
+    types
+}
 
 /// Makes every later [`read_motion`], [`read_motions`] and
 /// [`MotionSource::group`] in this process read files ending in one of
@@ -71,54 +141,51 @@ const BUILT_IN: [&str; 3] = ["bvh", "asf", "amc"];
 /// let err = read_motion("take.mine".as_ref()).unwrap_err();
 /// assert!(err.to_string().contains("not implemented"));
 /// ```
-pub fn register_reader(
-    extensions: &[&'static str],
-    describe: &'static str,
-    read: fn(&Path) -> Result<Motion>,
-) {
-    let extensions: Vec<String> = extensions
-        .iter()
-        .map(|e| e.trim_start_matches('.').to_ascii_lowercase())
-        .filter(|e| !e.is_empty() && !BUILT_IN.contains(&e.as_str()))
-        .collect();
-    if extensions.is_empty() {
-        return;
-    }
-    let mut readers = REGISTERED_READERS
-        .write()
-        .unwrap_or_else(|e| e.into_inner());
-    // A later registration takes its extensions over from earlier ones.
-    for reader in readers.iter_mut() {
-        reader.extensions.retain(|e| !extensions.contains(e));
-    }
-    readers.retain(|r| !r.extensions.is_empty());
-    readers.push(RegisteredReader {
+pub fn register_reader(extensions: &[&'static str], describe: &'static str, read: ReadFn) {
+    register(&REGISTERED_READERS, &BUILT_IN, extensions, describe, read);
+}
+
+/// Makes every later [`write_motion`] and [`write_motion_noted`] in this
+/// process write files ending in one of `extensions` (without the dot,
+/// matched in any case) with `write`, as [`register_reader`] does for
+/// reading: how a format whose library is too heavy for the core (glTF)
+/// reaches `mocap convert` and every command that writes motions.
+/// `describe` says what such a file is, for the error on a file of an
+/// unknown type. The latest registration of an extension wins; `bvh` keeps
+/// the core's writer.
+///
+/// ```
+/// use mocap_core::io::{register_writer, write_motion_noted};
+/// use mocap_core::{Error, Motion};
+///
+/// fn write_mine(path: &std::path::Path, _: &Motion) -> mocap_core::Result<Vec<String>> {
+///     Err(Error::Invalid(format!("{}: not implemented", path.display())))
+/// }
+/// register_writer(&["mine"], "my format", write_mine);
+/// # let walk = mocap_core::io::bvh::read_bvh(&mocap_testdata::sample_walk())?;
+/// let err = write_motion_noted("take.mine".as_ref(), &walk).unwrap_err();
+/// assert!(err.to_string().contains("not implemented"));
+/// # Ok::<(), mocap_core::Error>(())
+/// ```
+pub fn register_writer(extensions: &[&'static str], describe: &'static str, write: WriteFn) {
+    register(
+        &REGISTERED_WRITERS,
+        &BUILT_IN_WRITTEN,
         extensions,
         describe,
-        read,
-    });
+        write,
+    );
 }
 
 /// The reader registered for the lower-case `extension`, if any.
-fn registered_reader(extension: &str) -> Option<fn(&Path) -> Result<Motion>> {
-    REGISTERED_READERS
-        .read()
-        .unwrap_or_else(|e| e.into_inner())
-        .iter()
-        .find(|r| r.extensions.iter().any(|e| e == extension))
-        .map(|r| r.read)
+fn registered_reader(extension: &str) -> Option<ReadFn> {
+    registered(&REGISTERED_READERS, extension)
 }
 
 /// What the error on a file of an unknown type says the readers expect:
 /// the built-in formats, then the registered ones.
 fn expected_types() -> String {
-    let mut expected = String::from("expected .bvh, or .asf followed by .amc");
-    let readers = REGISTERED_READERS.read().unwrap_or_else(|e| e.into_inner());
-    for reader in readers.iter() {
-        let extensions: Vec<String> = reader.extensions.iter().map(|e| format!(".{e}")).collect();
-        expected += &format!(", or {} ({})", extensions.join(" or "), reader.describe);
-    }
-    expected
+    String::from("expected .bvh, or .asf followed by .amc") + &registered_types(&REGISTERED_READERS)
 }
 
 impl MotionSource {
@@ -228,14 +295,27 @@ pub fn read_motion(path: &Path) -> Result<Motion> {
     source.read()
 }
 
-/// Writes a motion to `path`, choosing the format from the extension.
+/// Writes a motion to `path`, choosing the format from the extension: BVH,
+/// or a format given with [`register_writer`]. The writer's notes are
+/// dropped; a converter that reports them calls [`write_motion_noted`].
 pub fn write_motion(path: &Path, motion: &Motion) -> Result<()> {
+    write_motion_noted(path, motion).map(drop)
+}
+
+/// Writes a motion as [`write_motion`] does and returns what the writer
+/// says it changed on the way (none for BVH; e.g. "lengths scaled by 0.01"
+/// for glTF, whose unit is the metre), for the person who asked.
+pub fn write_motion_noted(path: &Path, motion: &Motion) -> Result<Vec<String>> {
     match extension(path).as_str() {
-        "bvh" => bvh::write_bvh(path, motion),
-        _ => Err(Error::Invalid(format!(
-            "{}: can only write .bvh motion files",
-            path.display()
-        ))),
+        "bvh" => bvh::write_bvh(path, motion).map(|()| Vec::new()),
+        other => match registered(&REGISTERED_WRITERS, other) {
+            Some(write) => write(path, motion),
+            None => Err(Error::Invalid(format!(
+                "{}: cannot write this type of motion file (can write .bvh{})",
+                path.display(),
+                registered_types(&REGISTERED_WRITERS)
+            ))),
+        },
     }
 }
 
