@@ -3,18 +3,14 @@
 
 use mocap_fuse::{
     calibrate_from_body, center_truth, facing_of, fuse_streams, simulate, truth_from_motion,
-    BodyModel, Calibration, Fuser, FusionOptions, MeasureOptions, SensorStreams, SimulatedSensor,
-    SimulationOptions,
+    BodyModel, Calibration, Fuser, FusionOptions, GroundTruth, MeasureOptions, SensorStreams,
+    SimulatedSensor, Simulation, SimulationOptions,
 };
 
-#[test]
-fn fusion_and_body_calibration_on_a_real_take() {
-    let Some(path) = mocap_testdata::shared("bandai/dataset-1/dataset-1_walk_normal_001.bvh")
-    else {
-        return;
-    };
-    let motion = mocap_core::io::bvh::read_bvh(&path).unwrap();
-    let mut truth = truth_from_motion(&motion, None).unwrap();
+/// The take's Kinect joints, centred (on a treadmill beyond 2 m), and three
+/// simulated sensors watching them.
+fn three_sensors_watching(motion: &mocap_core::Motion) -> (GroundTruth, Simulation) {
+    let mut truth = truth_from_motion(motion, None).unwrap();
     center_truth(&mut truth, Some(2.0));
     let sim = simulate(
         &truth,
@@ -24,6 +20,17 @@ fn fusion_and_body_calibration_on_a_real_take() {
             ..Default::default()
         },
     );
+    (truth, sim)
+}
+
+#[test]
+fn fusion_and_body_calibration_on_a_real_take() {
+    let Some(path) = mocap_testdata::shared("bandai/dataset-1/dataset-1_walk_normal_001.bvh")
+    else {
+        return;
+    };
+    let motion = mocap_core::io::bvh::read_bvh(&path).unwrap();
+    let (truth, sim) = three_sensors_watching(&motion);
     let streams = SensorStreams::new(sim.sensors.iter().flat_map(|s| s.frames.iter().cloned()));
     let body = BodyModel::measure(
         sim.sensors
@@ -144,16 +151,7 @@ fn sensors_at_ten_frames_a_second_calibrate_from_the_body_at_their_own_rate() {
     // from both (gaps over 2.5 periods); at the recording's own period every
     // frame pairs, and the calibration comes out.
     let motion = mocap_core::io::bvh::read_bvh(&mocap_testdata::sample_walk()).unwrap();
-    let mut truth = truth_from_motion(&motion, None).unwrap();
-    center_truth(&mut truth, Some(2.0));
-    let sim = simulate(
-        &truth,
-        &SimulationOptions {
-            sensors: 3,
-            seed: 4,
-            ..Default::default()
-        },
-    );
+    let (_, sim) = three_sensors_watching(&motion);
     // The sensors' clocks are half a frame apart, so that pairs are made
     // between frames, not at shared instants.
     let streams = SensorStreams::new(sim.sensors.iter().enumerate().flat_map(|(k, s)| {
