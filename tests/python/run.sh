@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The Python package's tests, from a machine with only Python 3.11 and cargo:
-# a venv under ${CARGO_TARGET_DIR:-target}/py-venv with maturin, numpy and
-# pytest; the `mocap` CLI (the tests compare with its output); the wheel,
-# built by maturin and pip-installed into the venv; pytest on tests/python.
+# a venv under ${CARGO_TARGET_DIR:-target}/py-venv with maturin, numpy,
+# pytest and Ray (for mocap.batch); the `mocap` CLI (the tests compare with
+# its output); the wheel, built by maturin and pip-installed into the venv;
+# pytest on tests/python.
 #
 # The wheel is built in the dev profile at the test profile's opt-level (1,
 # see Cargo.toml): the capability crates' artifacts that `cargo test
@@ -22,6 +23,8 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 venv="$(cd "$venv" && pwd)"
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "maturin>=1.9.4,<2" numpy pytest
+# Ray, for mocap.batch's tests (an optional dependency: not in the wheel's metadata).
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check "ray[default]"
 
 echo "== the mocap CLI"
 cargo build --quiet -p mocap-cli
