@@ -127,6 +127,49 @@ def test_convert_equals_single_machine(local_ray, tmp_path, to):
     assert rec["metric"] == "frames" and rec["value"] == rec["frames"] > 0
 
 
+def test_index_equals_the_cli_byte_for_byte(local_ray, tmp_path, shared, cli):
+    # Bandai takes of several contents, labelled from their names; the
+    # features computed by Ray tasks, the forest trained once.
+    folder = shared / "bandai" / "dataset-1"
+    if not folder.is_dir():
+        pytest.skip(f"{folder} not found")
+    clips = tmp_path / "clips"
+    clips.mkdir()
+    for take in sorted(folder.glob("*.bvh"))[::20][:8]:
+        shutil.copy(take, clips / take.name)
+    shutil.copy(SAMPLE, clips / SAMPLE.name)
+    broken = clips / "dataset-1_walk_broken_001.bvh"
+    broken.write_text(SAMPLE.read_text()[:2000])
+    ours = tmp_path / "batch.idx"
+    result = batch.index(clips, ours, labels_from_name="bandai-content", trees=12,
+                         progress=False)
+    # The broken clip is recorded, the others indexed.
+    count = len(list(clips.glob("*.bvh")))
+    assert count >= 8
+    assert (result.total, result.done, result.failed) == (count, count - 1, 1), result.errors
+    assert result.errors[0][0] == str(broken) and "MocapError" in result.errors[0][1]
+    records = manifest_lines(result.manifest)
+    assert sorted(r["status"] for r in records) == ["done"] * (count - 1) + ["error"]
+    # The command on the same clips (without the broken one) writes the same file.
+    broken.unlink()
+    theirs = tmp_path / "cli.idx"
+    subprocess.run([cli, "search", "index", str(clips), "--labels-from-name", "bandai-content",
+                    "--trees", "12", "-o", str(theirs), "-q"], check=True)
+    assert ours.read_bytes() == theirs.read_bytes()
+    # And the index answers queries.
+    report = mocap.search.Index.load(ours).query(mocap.read(SAMPLE), top=3)
+    assert len(report.matches) == 3
+
+
+def test_index_bad_inputs_fail_before_any_work(tmp_path):
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(batch.BatchError, match="no clips"):
+        batch.index(tmp_path / "empty", tmp_path / "x.idx", labels_from_name="bandai-content")
+    with pytest.raises(batch.BatchError, match="labels"):
+        batch.index(SAMPLE, tmp_path / "x.idx")
+    assert not (tmp_path / "x.idx").exists()
+
+
 def test_bad_take_recorded_and_others_finish(local_ray, tmp_path):
     takes = make_tree(tmp_path / "in")
     bad = tmp_path / "in" / "sub" / "truncated.bvh"

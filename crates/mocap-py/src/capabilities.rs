@@ -20,6 +20,7 @@ use mocap_fuse::{
 use mocap_nn::device::DeviceChoice;
 use mocap_search::{motion_features, Ranking};
 use mocap_style::{apply as style_apply_files, ApplyOptions};
+use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::errors::{self, invalid};
@@ -216,6 +217,116 @@ pub fn fuse_run(
     })
     .map(PyMotion::new)
     .map_err(errors::core)
+}
+
+/// One clip of a search index to build, as `mocap.batch.index` passes it:
+/// its path, label and performer.
+type LabelledClip = (PathBuf, String, Option<String>);
+
+/// The clips `mocap search index` would index for `inputs` (files and
+/// folders), in its order, with their labels from a label file or a
+/// file-name pattern, and the rule's name: `mocap.batch.index`'s first
+/// step, before any work is sent out.
+#[pyfunction]
+#[pyo3(signature = (inputs, labels = None, labels_from_name = None))]
+pub fn search_clips(
+    inputs: Vec<PathBuf>,
+    labels: Option<PathBuf>,
+    labels_from_name: Option<String>,
+) -> PyResult<(Vec<LabelledClip>, String)> {
+    let (rule, rule_name) =
+        mocap_search::LabelRule::from_options(labels.as_deref(), labels_from_name.as_deref())
+            .map_err(errors::search)?;
+    let clips = mocap_search::motion_files(&inputs)
+        .and_then(|paths| {
+            paths
+                .into_iter()
+                .map(|path| {
+                    let label = rule.label_of(&path)?;
+                    Ok((path, label.label, label.performer))
+                })
+                .collect()
+        })
+        .map_err(errors::search)?;
+    Ok((clips, rule_name))
+}
+
+/// One clip's per-frame pose features (frames x values, float32) and frame
+/// rate: the work of one `mocap.batch.index` task.
+#[pyfunction]
+pub fn search_features<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, numpy::PyArray2<f32>>, f64)> {
+    let (features, fps) = py
+        .detach(|| mocap_search::load_features(&path))
+        .map_err(errors::search)?;
+    let dim = features.dim;
+    let frames = features.frame_count();
+    let array = numpy::PyArray1::from_vec(py, features.values).reshape([frames, dim])?;
+    Ok((array, fps))
+}
+
+/// Builds a search index from labelled clips and their features (from
+/// [`search_clips`] and [`search_features`]) and writes it to `output`,
+/// as `mocap search index` with the same settings does: the same clips in
+/// the same order give the same file, byte for byte. Returns the numbers
+/// of clips and classes.
+#[pyfunction]
+#[pyo3(signature = (clips, features, rule_name, output, trees = 100, candidates = 64, min_entropy = 0.0, frames = 10, seed = 1, bootstrap = true))]
+#[allow(clippy::too_many_arguments)]
+pub fn search_build_index(
+    py: Python<'_>,
+    clips: Vec<LabelledClip>,
+    features: Vec<(numpy::PyReadonlyArray2<'_, f32>, f64)>,
+    rule_name: String,
+    output: PathBuf,
+    trees: usize,
+    candidates: usize,
+    min_entropy: f32,
+    frames: usize,
+    seed: u64,
+    bootstrap: bool,
+) -> PyResult<(usize, usize)> {
+    if clips.len() != features.len() {
+        return Err(invalid(format!(
+            "{} clips but {} feature arrays",
+            clips.len(),
+            features.len()
+        )));
+    }
+    let clips: Vec<mocap_search::Clip> = clips
+        .into_iter()
+        .zip(features)
+        .map(|((path, label, performer), (values, fps))| {
+            let dim = values.shape()[1];
+            mocap_search::Clip {
+                path,
+                label,
+                performer,
+                fps,
+                features: mocap_search::FeatureSequence {
+                    dim,
+                    values: values.as_array().iter().copied().collect(),
+                },
+            }
+        })
+        .collect();
+    let mut config = mocap_search::IndexConfig {
+        frames,
+        ..Default::default()
+    };
+    config.forest.trees = trees;
+    config.forest.tree.candidates_per_node = Some(candidates);
+    config.forest.tree.min_entropy = min_entropy;
+    config.forest.seed = seed;
+    config.forest.bootstrap = bootstrap;
+    py.detach(|| {
+        let index = mocap_search::build_index(&clips, &rule_name, &config, false)?;
+        index.save(&output)?;
+        Ok((index.clips.len(), index.classes.len()))
+    })
+    .map_err(errors::search)
 }
 
 /// The search library shipped with mocap (Bandai contents), for

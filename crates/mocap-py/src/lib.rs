@@ -9,7 +9,8 @@
 //!
 //! - `motion`: `mocap.Motion`, `mocap.Skeleton`, `mocap.read`;
 //! - `capabilities`: `clean`, `feet`, `retarget`, `resample`, `mirror`,
-//!   `mocap.search.Index`, `mocap.style.apply`, `mocap.fuse.run`;
+//!   `mocap.search.Index` (and the steps of `mocap.batch.index`),
+//!   `mocap.style.apply`, `mocap.fuse.run`;
 //! - `errors`: Rust errors as `mocap.MocapError` (a `ValueError`) or
 //!   `OSError`, with the Rust message (file, line and column).
 //!
@@ -45,6 +46,9 @@ fn _mocap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capabilities::mirror, m)?)?;
     m.add_function(wrap_pyfunction!(capabilities::style_apply, m)?)?;
     m.add_function(wrap_pyfunction!(capabilities::fuse_run, m)?)?;
+    m.add_function(wrap_pyfunction!(capabilities::search_clips, m)?)?;
+    m.add_function(wrap_pyfunction!(capabilities::search_features, m)?)?;
+    m.add_function(wrap_pyfunction!(capabilities::search_build_index, m)?)?;
     m.add_class::<capabilities::PyIndex>()?;
     m.add_class::<capabilities::PyQueryResult>()?;
     m.add_class::<capabilities::PyMatch>()?;

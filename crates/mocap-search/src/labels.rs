@@ -41,6 +41,28 @@ pub enum LabelRule {
 }
 
 impl LabelRule {
+    /// The rule a command line asks for: a label file (`--labels FILE`) or
+    /// a file-name pattern or preset (`--labels-from-name PATTERN`), with
+    /// its name for reports (the file's path, or the pattern).
+    pub fn from_options(
+        file: Option<&Path>,
+        pattern: Option<&str>,
+    ) -> Result<(LabelRule, String), SearchError> {
+        match (file, pattern) {
+            (Some(file), _) => Ok((
+                LabelRule::FromFile(LabelFile::read(file)?),
+                file.display().to_string(),
+            )),
+            (None, Some(pattern)) => Ok((
+                LabelRule::FromName(NamePattern::parse(pattern)?),
+                pattern.to_string(),
+            )),
+            (None, None) => Err(SearchError::Invalid(
+                "give --labels FILE or --labels-from-name PATTERN".into(),
+            )),
+        }
+    }
+
     /// The label of the clip stored at `path`.
     pub fn label_of(&self, path: &Path) -> Result<ClipLabel, SearchError> {
         match self {

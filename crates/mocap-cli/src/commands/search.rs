@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use mocap_search::{
-    evaluate_files, find_in_take, index_files, EvalConfig, Index, IndexConfig, LabelFile,
-    LabelRule, NamePattern, Ranking, SplitRule, TakeMethod, TakeSearchConfig,
+    evaluate_files, find_in_take, index_files, EvalConfig, Index, IndexConfig, LabelRule, Ranking,
+    SplitRule, TakeMethod, TakeSearchConfig,
 };
 
 use super::args::ReportArgs;
@@ -44,17 +44,10 @@ struct SearchLabelArgs {
 
 impl SearchLabelArgs {
     fn rule(&self) -> anyhow::Result<(LabelRule, String)> {
-        Ok(match (&self.labels, &self.labels_from_name) {
-            (Some(file), _) => (
-                LabelRule::FromFile(LabelFile::read(file)?),
-                file.display().to_string(),
-            ),
-            (None, Some(pattern)) => (
-                LabelRule::FromName(NamePattern::parse(pattern)?),
-                pattern.clone(),
-            ),
-            (None, None) => bail!("give --labels FILE or --labels-from-name PATTERN"),
-        })
+        Ok(LabelRule::from_options(
+            self.labels.as_deref(),
+            self.labels_from_name.as_deref(),
+        )?)
     }
 }
 

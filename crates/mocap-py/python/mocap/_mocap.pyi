@@ -210,3 +210,28 @@ class Index:
         """Classifies a clip (a Motion or a path) and ranks the library's clips
         by similarity (the best ``top``), as ``mocap search query``."""
     def __len__(self) -> int: ...
+
+# The steps of mocap.batch.index (use that, not these).
+def search_clips(
+    inputs: Sequence[PathLike],
+    labels: Optional[PathLike] = None,
+    labels_from_name: Optional[str] = None,
+) -> tuple[list[tuple[str, str, Optional[str]]], str]:
+    """The clips ``mocap search index`` would index, in its order, with their
+    labels and performers, and the label rule's name."""
+def search_features(path: PathLike) -> tuple[FloatArray, float]:
+    """One clip's per-frame pose features (frames x values) and frame rate."""
+def search_build_index(
+    clips: Sequence[tuple[str, str, Optional[str]]],
+    features: Sequence[tuple[FloatArray, float]],
+    rule_name: str,
+    output: PathLike,
+    trees: int = 100,
+    candidates: int = 64,
+    min_entropy: float = 0.0,
+    frames: int = 10,
+    seed: int = 1,
+    bootstrap: bool = True,
+) -> tuple[int, int]:
+    """Trains the forest on the clips and writes the index, as ``mocap search
+    index``; returns the numbers of clips and classes."""

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Literal, Optional, Sequence, Union
 
-__all__ = ["BatchError", "BatchResult", "clean", "convert"]
+__all__ = ["BatchError", "BatchResult", "clean", "convert", "index"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 Inputs = Union[PathLike, Sequence[PathLike]]
@@ -521,3 +521,129 @@ def convert(
         "convert", inputs, output_dir, "." + to, options, address, manifest, progress,
         num_cpus, max_retries, resume,
     )
+
+
+# ---------------------------------------------------------------- index
+
+
+def clip_features(path: str) -> dict[str, Any]:
+    """One clip's pose features for a search index (what each Ray task of
+    :func:`index` runs). An error is returned in the record, not raised."""
+    from mocap import _mocap
+
+    start = time.perf_counter()
+    record: dict[str, Any] = {"input": path, "status": "error", "op": "index"}
+    try:
+        _test_hook("start", path)
+        values, fps = _mocap.search_features(path)
+        record.update(status="done", error=None, frames=int(values.shape[0]),
+                      values=values, fps=fps)
+        _test_hook("finish", path)
+    except Exception as e:
+        record.update(error=f"{type(e).__name__}: {e}", frames=None)
+    record["seconds"] = round(time.perf_counter() - start, 4)
+    return record
+
+
+def index(
+    inputs: Union[PathLike, Sequence[PathLike]],
+    output: PathLike,
+    *,
+    labels: Optional[PathLike] = None,
+    labels_from_name: Optional[str] = None,
+    trees: int = 100,
+    candidates: int = 64,
+    min_entropy: float = 0.0,
+    frames: int = 10,
+    seed: int = 1,
+    bootstrap: bool = True,
+    address: Optional[str] = None,
+    progress: bool = True,
+    num_cpus: Optional[int] = None,
+    max_retries: int = DEFAULT_MAX_RETRIES,
+) -> BatchResult:
+    """Builds a search index of the clips of ``inputs`` (files and folders,
+    as ``mocap search index`` takes them) and writes it to ``output``: each
+    clip's pose features are computed by a Ray task, the forest is trained
+    once on this machine. Labels come from a label file (``labels``) or a
+    file-name pattern or preset (``labels_from_name``, e.g.
+    "bandai-content"); the forest settings are the command's. The same
+    inputs and settings give the same file as ``mocap search index``, byte
+    for byte.
+
+    A clip that cannot be read is recorded in the manifest
+    (``OUTPUT.manifest.jsonl``, one line per clip) and left out of the
+    index. Raises BatchError before any work when the labels cannot be
+    found, no clip is found, or ``output`` cannot be written."""
+    from mocap import _mocap
+
+    start = time.perf_counter()
+    given = [inputs] if isinstance(inputs, (str, os.PathLike)) else list(inputs)
+    try:
+        clips, rule_name = _mocap.search_clips(
+            [os.fspath(p) for p in given],
+            os.fspath(labels) if labels else None,
+            labels_from_name,
+        )
+    except (ValueError, OSError) as e:
+        raise BatchError(str(e)) from e
+    if not clips:
+        raise BatchError(f"no clips (.bvh, .amc) found in {', '.join(map(os.fspath, given))}")
+    output = Path(output).expanduser()
+    _check_output_dir(output.parent.resolve())
+    manifest_path = output.with_name(output.name + ".manifest.jsonl")
+
+    owned = _connect(address, num_cpus)
+    result = BatchResult(total=len(clips), done=0, failed=0, skipped=0, seconds=0.0,
+                         manifest=manifest_path, output_dir=output.parent)
+    bar = _Progress("index", len(clips), 0, progress)
+    features: dict[str, tuple[Any, float]] = {}
+    try:
+        ray = _import_ray()
+        task = ray.remote(num_cpus=1, max_retries=max_retries)(clip_features)
+        window = max(16, 4 * int(ray.cluster_resources().get("CPU", 1)))
+        pending: dict[Any, str] = {}
+        queue = iter(str(path) for path, _, _ in clips)
+        with open(manifest_path, "w", encoding="utf-8") as log:
+            while True:
+                while len(pending) < window:
+                    path = next(queue, None)
+                    if path is None:
+                        break
+                    pending[task.remote(path)] = path
+                if not pending:
+                    break
+                ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
+                for ref in ready:
+                    path = pending.pop(ref)
+                    try:
+                        rec = ray.get(ref)
+                    except Exception as e:  # retries ran out (a node died each time)
+                        rec = {"input": path, "status": "error", "op": "index",
+                               "error": f"{type(e).__name__}: {e}".splitlines()[0]}
+                    if rec["status"] == "done":
+                        features[path] = (rec.pop("values"), rec.pop("fps"))
+                        result.done += 1
+                        bar.done += 1
+                    else:
+                        result.failed += 1
+                        bar.failed += 1
+                        result.errors.append((path, rec.get("error") or ""))
+                    log.write(json.dumps(rec) + "\n")
+                    log.flush()
+                bar.update()
+    finally:
+        if owned:
+            _import_ray().shutdown()
+    bar.update(force=True)
+    kept = [clip for clip in clips if str(clip[0]) in features]
+    if not kept:
+        raise BatchError(f"no clip could be read (see {manifest_path})")
+    # The clips in the order `mocap search index` takes them.
+    _mocap.search_build_index(
+        kept, [features[str(clip[0])] for clip in kept], rule_name, os.fspath(output),
+        trees=trees, candidates=candidates, min_entropy=min_entropy, frames=frames,
+        seed=seed, bootstrap=bootstrap,
+    )
+    result.seconds = time.perf_counter() - start
+    return result

@@ -1,4 +1,4 @@
-"""``python -m mocap.batch clean|convert IN... -o OUT``: a batch on Ray.
+"""``python -m mocap.batch clean|convert|index IN... -o OUT``: a batch on Ray.
 
 Exit codes: 0 every take done, 1 bad input (nothing was processed),
 3 some takes failed (listed in the manifest).
@@ -10,7 +10,7 @@ import argparse
 import sys
 from typing import Optional, Sequence
 
-from . import BatchError, clean, convert
+from . import BatchError, clean, convert, index
 
 EXIT_BAD_INPUT = 1
 EXIT_SOME_FAILED = 3
@@ -19,7 +19,7 @@ EXIT_SOME_FAILED = 3
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m mocap.batch",
-        description="Clean or convert an archive of takes, one Ray task per take (docs/scale.md).",
+        description="Clean, convert or index an archive of takes, one Ray task per take (docs/scale.md).",
     )
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -54,11 +54,45 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--to", choices=["bvh", "glb", "gltf"], required=True)
     v.add_argument("--fps", type=float, default=None, help="resample to this frame rate")
     v.add_argument("--mirror", action="store_true", help="swap left and right")
+
+    x = sub.add_parser("index", help="build a search index (as mocap search index)")
+    x.add_argument("inputs", nargs="+", metavar="IN", help="clip files and folders")
+    x.add_argument("-o", "--output", required=True, metavar="INDEX", help="the index file")
+    x.add_argument("--labels", default=None, metavar="FILE", help="a CSV/TSV of path,label[,performer]")
+    x.add_argument("--labels-from-name", default=None, metavar="PATTERN",
+                   help="a file-name pattern or preset (bandai-content, ...)")
+    x.add_argument("--trees", type=int, default=100)
+    x.add_argument("--candidates", type=int, default=64)
+    x.add_argument("--min-entropy", type=float, default=0.0)
+    x.add_argument("--frames", type=int, default=10)
+    x.add_argument("--seed", type=int, default=1)
+    x.add_argument("--no-bootstrap", action="store_true")
+    x.add_argument("--address", default=None, metavar="ADDR",
+                   help="local (default), auto, HOST:PORT or ray://HOST:PORT")
+    x.add_argument("--num-cpus", type=int, default=None, metavar="N")
+    x.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     return p
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     args = _parser().parse_args(argv)
+    if args.command == "index":
+        try:
+            result = index(
+                args.inputs, args.output, labels=args.labels,
+                labels_from_name=args.labels_from_name, trees=args.trees,
+                candidates=args.candidates, min_entropy=args.min_entropy, frames=args.frames,
+                seed=args.seed, bootstrap=not args.no_bootstrap, address=args.address,
+                progress=not args.quiet, num_cpus=args.num_cpus,
+            )
+        except BatchError as e:
+            print(f"error: {e}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        print(f"indexed {result.done} of {result.total} clips into {args.output}"
+              f" in {result.seconds:.1f} s; manifest {result.manifest}")
+        for source, error in result.errors[:10]:
+            print(f"failed: {source}: {error}", file=sys.stderr)
+        return EXIT_SOME_FAILED if result.failed else 0
     common = dict(
         address=args.address, manifest=args.manifest, progress=not args.quiet,
         num_cpus=args.num_cpus, max_retries=args.max_retries, resume=not args.no_resume,
