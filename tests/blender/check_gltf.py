@@ -27,10 +27,14 @@ holds every frame and the largest distance is within `tolerance` metres
 """
 
 import json
+import os
 import struct
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from harness import run_checks  # noqa: E402
 
 
 def work_around_numpy_bool():
@@ -43,27 +47,6 @@ def work_around_numpy_bool():
 
     if not hasattr(numpy, "bool"):
         numpy.bool = bool
-
-
-def parse_arguments(argv):
-    args = argv[argv.index("--") + 1:] if "--" in argv else []
-    tolerance = 1e-3
-    report = None
-    files = []
-    i = 0
-    while i < len(args):
-        if args[i] == "--tolerance":
-            tolerance = float(args[i + 1])
-            i += 2
-        elif args[i] == "--report":
-            report = args[i + 1]
-            i += 2
-        else:
-            files.append(args[i])
-            i += 1
-    if not files or len(files) % 2:
-        raise SystemExit("expected pairs of glTF file and positions JSON after --")
-    return list(zip(files[0::2], files[1::2])), tolerance, report
 
 
 def gltf_json(path):
@@ -157,17 +140,7 @@ def check(path, positions_path, tolerance):
 
 def main():
     work_around_numpy_bool()
-    pairs, tolerance, report = parse_arguments(sys.argv)
-    results = [check(g, p, tolerance) for g, p in pairs]
-    for r in results:
-        print("BLENDER-GLTF " + json.dumps(r))
-    if report:
-        with open(report, "w") as f:
-            json.dump({"blender": bpy.app.version_string, "results": results}, f, indent=1)
-    failed = [r["file"] for r in results if not r.get("passed")]
-    if failed:
-        print("BLENDER-GLTF failed: " + ", ".join(failed))
-        sys.exit(1)
+    run_checks(check, "glTF", "BLENDER-GLTF")
 
 
 main()

@@ -27,9 +27,13 @@ agree frame for frame, so an off-by-one would show as errors of centimetres.
 
 import builtins
 import json
+import os
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from harness import run_checks  # noqa: E402
 
 
 def work_around_open_mode_ru():
@@ -49,27 +53,6 @@ def work_around_open_mode_ru():
 
     import_bvh.open = open_without_u
     return True
-
-
-def parse_arguments(argv):
-    args = argv[argv.index("--") + 1:] if "--" in argv else []
-    tolerance = 1e-3
-    report = None
-    files = []
-    i = 0
-    while i < len(args):
-        if args[i] == "--tolerance":
-            tolerance = float(args[i + 1])
-            i += 2
-        elif args[i] == "--report":
-            report = args[i + 1]
-            i += 2
-        else:
-            files.append(args[i])
-            i += 1
-    if not files or len(files) % 2:
-        raise SystemExit("expected pairs of BVH file and positions JSON after --")
-    return list(zip(files[0::2], files[1::2])), tolerance, report
 
 
 def check(bvh_path, positions_path, tolerance):
@@ -154,17 +137,7 @@ def check(bvh_path, positions_path, tolerance):
 
 
 def main():
-    pairs, tolerance, report = parse_arguments(sys.argv)
-    results = [check(b, p, tolerance) for b, p in pairs]
-    for r in results:
-        print("BLENDER-CHECK " + json.dumps(r))
-    if report:
-        with open(report, "w") as f:
-            json.dump({"blender": bpy.app.version_string, "results": results}, f, indent=1)
-    failed = [r["file"] for r in results if not r["passed"]]
-    if failed:
-        print("BLENDER-CHECK failed: " + ", ".join(failed))
-        sys.exit(1)
+    run_checks(check, "BVH", "BLENDER-CHECK")
 
 
 main()
