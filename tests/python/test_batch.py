@@ -170,6 +170,25 @@ def test_index_bad_inputs_fail_before_any_work(tmp_path):
     assert not (tmp_path / "x.idx").exists()
 
 
+def test_asf_amc_takes(local_ray, tmp_path, shared):
+    # An AMC take is read with the ASF skeleton beside it, as `mocap.read` does.
+    folder = shared / "hdm05-sample"
+    if not folder.is_dir():
+        pytest.skip(f"{folder} not found")
+    amc = folder / "HDM_bd_depositFloorR_001_120.amc"
+    result = batch.convert(folder, tmp_path / "out", to="bvh", progress=False)
+    assert (result.total, result.done, result.failed) == (1, 1, 0), result.errors
+    ref = tmp_path / "ref" / "HDM_bd_depositFloorR_001_120.bvh"
+    ref.parent.mkdir()
+    mocap.read(amc).write(ref)
+    assert (tmp_path / "out" / ref.name).read_bytes() == ref.read_bytes()
+    result = batch.clean(amc, tmp_path / "clean", filter=FILTER, progress=False)
+    assert result.done == 1, result.errors
+    # Cleaned takes are written as BVH (a/b.amc -> OUT/a/b.bvh).
+    cleaned = tmp_path / "clean" / ref.name
+    assert cleaned.read_bytes() == reference_clean(amc, tmp_path / "ref" / "clean.bvh", filter=FILTER)
+
+
 def test_bad_take_recorded_and_others_finish(local_ray, tmp_path):
     takes = make_tree(tmp_path / "in")
     bad = tmp_path / "in" / "sub" / "truncated.bvh"
@@ -256,7 +275,7 @@ def cluster():
     tmp = Path(short_tmp("mcl"))
     pids = tmp / "pids"
     pids.mkdir()
-    port, head_nm, worker_nm = free_port(), free_port(), free_port()
+    port, head_nm, worker_nm, client = free_port(), free_port(), free_port(), free_port()
     env = dict(os.environ, RAY_AUTH_MODE="token", RAY_AUTH_TOKEN=os.urandom(16).hex(),
                MOCAP_BATCH_TEST_PIDS=str(pids), MOCAP_BATCH_TEST_DELAY="0.6",
                RAY_health_check_period_ms="500", RAY_health_check_failure_threshold="3",
@@ -264,11 +283,13 @@ def cluster():
     common = ["--num-cpus=1", "--disable-usage-stats"]
     try:
         subprocess.run([ray_bin, "start", "--head", f"--port={port}", f"--node-manager-port={head_nm}",
-                        "--include-dashboard=false", f"--temp-dir={tmp / 'ray'}", *common],
+                        f"--ray-client-server-port={client}", "--include-dashboard=false",
+                        f"--temp-dir={tmp / 'ray'}", *common],
                        env=env, check=True, capture_output=True, timeout=120)
         subprocess.run([ray_bin, "start", f"--address=127.0.0.1:{port}", f"--node-manager-port={worker_nm}",
                         *common], env=env, check=True, capture_output=True, timeout=120)
-        yield {"address": f"127.0.0.1:{port}", "env": env, "pids": pids, "worker_nm": worker_nm}
+        yield {"address": f"127.0.0.1:{port}", "client": f"ray://127.0.0.1:{client}", "env": env,
+               "pids": pids, "worker_nm": worker_nm}
     finally:
         subprocess.run([ray_bin, "stop", "--force"], env=env, capture_output=True, timeout=120)
         shutil.rmtree(tmp, ignore_errors=True)
@@ -292,6 +313,21 @@ def test_cluster_cli(cluster, tmp_path):
     r = run_cli("clean", tmp_path / "in", "-o", tmp_path / "out", "--filter", FILTER,
                 "--address", cluster["address"], "-q", env=cluster["env"])
     assert r.returncode == 3 and "0 done, 4 skipped as done before, 1 failed of 5 takes" in r.stdout
+
+
+def test_ray_client_address(cluster, tmp_path):
+    # A driver that is not on a node: Ray Client (ray://HOST:PORT).
+    make_tree(tmp_path / "in")
+    r = run_cli("convert", tmp_path / "in", "-o", tmp_path / "out", "--to", "glb",
+                "--address", cluster["client"], "-q", env=cluster["env"])
+    assert r.returncode == 0, r.stderr
+    assert "4 done, 0 skipped as done before, 0 failed of 4 takes" in r.stdout
+    for take in (tmp_path / "in").rglob("*.bvh"):
+        out = (tmp_path / "out" / take.relative_to(tmp_path / "in")).with_suffix(".glb")
+        ref = tmp_path / "ref" / out.name
+        ref.parent.mkdir(exist_ok=True)
+        mocap.read(take).write(ref)
+        assert out.read_bytes() == ref.read_bytes(), out
 
 
 def worker_raylet(node_manager_port: int) -> int:
