@@ -3,8 +3,8 @@
 
 use mocap_fuse::{
     calibrate_from_body, center_truth, facing_of, fuse_streams, simulate, truth_from_motion,
-    BodyModel, Calibration, Fuser, FusionOptions, GroundTruth, MeasureOptions, SensorStreams,
-    SimulatedSensor, Simulation, SimulationOptions,
+    BodyModel, Calibration, Fuser, FusionOptions, GroundTruth, MeasureOptions, SensorPose,
+    SensorStreams, SimulatedSensor, Simulation, SimulationOptions,
 };
 
 /// The take's Kinect joints, centred (on a treadmill beyond 2 m), and three
@@ -21,6 +21,24 @@ fn three_sensors_watching(motion: &mocap_core::Motion) -> (GroundTruth, Simulati
         },
     );
     (truth, sim)
+}
+
+/// How far a sensor's pose found from the body (relative to the reference
+/// sensor) is from the simulation's truth: degrees and metres.
+fn calibration_error(sim: &Simulation, reference: u16, found: &SensorPose) -> (f32, f32) {
+    let truth = sim.sensors[reference as usize]
+        .pose
+        .inverse()
+        .then_after(&sim.sensors[found.id as usize].pose);
+    let angle = found
+        .transform
+        .rotation
+        .angle_between(truth.rotation)
+        .to_degrees();
+    (
+        angle,
+        (found.transform.translation - truth.translation).length(),
+    )
 }
 
 #[test]
@@ -90,15 +108,7 @@ fn fusion_and_body_calibration_on_a_real_take() {
     let world_from_reference = sim.sensors[found.reference as usize].pose;
     let mut body_calibration = found.calibration.clone();
     for s in &mut body_calibration.sensors {
-        let truth = world_from_reference
-            .inverse()
-            .then_after(&sim.sensors[s.id as usize].pose);
-        let angle = s
-            .transform
-            .rotation
-            .angle_between(truth.rotation)
-            .to_degrees();
-        let shift = (s.transform.translation - truth.translation).length();
+        let (angle, shift) = calibration_error(&sim, found.reference, s);
         eprintln!(
             "sensor {}: body calibration off by {angle:.2} degrees, {shift:.3} m",
             s.id
@@ -172,16 +182,8 @@ fn sensors_at_ten_frames_a_second_calibrate_from_the_body_at_their_own_rate() {
             report.paired_frames
         );
     }
-    let world_from_reference = sim.sensors[found.reference as usize].pose;
     for s in &found.calibration.sensors {
-        let truth = world_from_reference
-            .inverse()
-            .then_after(&sim.sensors[s.id as usize].pose);
-        let angle = s
-            .transform
-            .rotation
-            .angle_between(truth.rotation)
-            .to_degrees();
+        let (angle, _) = calibration_error(&sim, found.reference, s);
         assert!(angle < 10.0, "sensor {}: {angle} degrees", s.id);
     }
 }
