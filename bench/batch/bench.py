@@ -1,6 +1,7 @@
-"""Takes/s of mocap.batch.clean (the shipped model) with 1 and 2 local Ray
-workers against plain loops: `mocap clean apply` per take, and mocap.clean in
-one Python process. Writes a Markdown table to stdout (bench/batch/run.sh)."""
+"""Takes/s of mocap.batch (clean with the shipped model, and index) with 1
+and 2 local Ray workers against plain loops over the same Bandai takes: the
+CLI per take, and mocap.clean in one Python process. Writes Markdown to
+stdout (bench/batch/run.sh); progress to stderr."""
 
 import os
 import platform
@@ -11,61 +12,120 @@ import tempfile
 import time
 from pathlib import Path
 
+import ray
+
 import mocap
 import mocap.batch
 
-folder, count, cli = Path(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-takes = sorted(folder.glob("*.bvh"))[:count]
+folder, count, cli = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+takes = sorted(folder.rglob("*.bvh"))
+if count != "all":
+    takes = takes[: int(count)]
 assert takes, f"no .bvh takes in {folder}"
-seconds = sum(len(mocap.read(t)) * mocap.read(t).frame_time for t in takes)
+n = len(takes)
+seconds = sum(len(m) * m.frame_time for m in map(mocap.read, takes))
 work = Path(tempfile.mkdtemp(prefix="mbb"))
 rows = []
 
 
-def row(name, wall, note=""):
-    rows.append(f"| {name} | {wall:.1f} | {len(takes) / wall:.2f} | {seconds / wall:.1f} | {note} |")
-    print(rows[-1], file=sys.stderr, flush=True)
+def log(*args):
+    print(*args, file=sys.stderr, flush=True)
 
 
+def row(table, name, wall, note=""):
+    table.append(f"| {name} | {wall:.1f} | {n / wall:.2f} | {seconds / wall:.1f} | {note} |")
+    log(table[-1])
+
+
+def task_seconds(manifest):
+    return sum(rec["seconds"] for rec in mocap.batch.read_manifest(manifest).values())
+
+
+# Ray's start and stop on this machine, paid once per run.
+start = time.perf_counter()
+ray.init(num_cpus=2, include_dashboard=False, logging_level="WARNING")
+ray.shutdown()
+ray_start = time.perf_counter() - start
+log(f"ray start and stop: {ray_start:.1f} s")
+
+# ---- clean
+clean = []
 (work / "cli").mkdir()
 start = time.perf_counter()
 for t in takes:
     subprocess.run([cli, "clean", "apply", "-q", "-o", str(work / "cli" / t.name), str(t)], check=True)
-row("loop: `mocap clean apply` per take", time.perf_counter() - start, f"`{cli}`")
+row(clean, "loop: `mocap clean apply` per take", time.perf_counter() - start)
 
 start = time.perf_counter()
 (work / "py").mkdir()
 for t in takes:
     mocap.clean(mocap.read(t)).write(work / "py" / t.name)
-row("loop: `mocap.clean` in one Python process", time.perf_counter() - start,
-    f"the installed wheel ({Path(mocap.__file__).parent})")
+py_wall = time.perf_counter() - start
+row(clean, "loop: `mocap.clean` in one Python process", py_wall)
 
-rates = {}
+in_task = {}
+walls = {}
 for cpus in (1, 2):
     start = time.perf_counter()
     r = mocap.batch.clean(takes, work / f"ray{cpus}", num_cpus=cpus, progress=False)
-    assert r.done == len(takes), r.errors
-    task_s = sum(rec["seconds"] for rec in mocap.batch.read_manifest(r.manifest).values())
-    rates[cpus] = task_s
-    row(f"`mocap.batch.clean`, local Ray, {cpus} worker(s)", time.perf_counter() - start,
-        f"wall includes starting Ray; {task_s / len(takes):.2f} s a take in its task")
-    for t in takes:  # the same output as the plain loop
-        assert (work / f"ray{cpus}" / t.name).read_bytes() == (work / "py" / t.name).read_bytes()
+    walls[cpus] = time.perf_counter() - start
+    assert r.done == n, r.errors
+    in_task[cpus] = task_seconds(r.manifest)
+    row(clean, f"`mocap.batch.clean`, local Ray, {cpus} worker(s)", walls[cpus],
+        f"{in_task[cpus] / n:.3f} s a take in its task")
+    for t in takes:  # the same output as the plain loop, byte for byte
+        out = work / f"ray{cpus}" / t.name  # a list of takes: outputs by name
+        assert out.read_bytes() == (work / "py" / t.name).read_bytes(), out
+    shutil.rmtree(work / f"ray{cpus}")
 
-print(f"{len(takes)} Bandai takes ({seconds:.0f} s of motion) from `{folder}`, the shipped model, "
-      f"{os.cpu_count()} cores, {platform.processor() or platform.machine()}, Python {platform.python_version()}.\n")
-print("| run | wall s | takes/s | motion s per wall s | note |\n|---|---|---|---|---|")
-print("\n".join(rows))
+# ---- index: features per clip on Ray, one forest
+index = []
+labels = ["--labels-from-name", "bandai-content"]
+start = time.perf_counter()
+subprocess.run([cli, "search", "index", *map(str, takes), *labels, "-q", "-o", str(work / "cli.idx")],
+               check=True)
+row(index, "`mocap search index` (one process)", time.perf_counter() - start)
+for cpus in (1, 2):
+    start = time.perf_counter()
+    r = mocap.batch.index(takes, work / f"ray{cpus}.idx", labels_from_name="bandai-content",
+                          num_cpus=cpus, progress=False)
+    wall = time.perf_counter() - start
+    assert r.done == n, r.errors
+    same = (work / f"ray{cpus}.idx").read_bytes() == (work / "cli.idx").read_bytes()
+    assert same, "the batch index differs from the command's"
+    row(index, f"`mocap.batch.index`, local Ray, {cpus} worker(s)", wall,
+        f"{task_seconds(r.manifest) / n:.3f} s a clip in its task; the same file as the command")
+
+head = "| run | wall s | takes/s | motion s per wall s | note |\n|---|---|---|---|---|"
+print(f"{n} Bandai takes ({seconds / 60:.0f} min of motion) under `{folder}`, "
+      f"{os.cpu_count()} cores, {platform.processor() or platform.machine()}, "
+      f"Python {platform.python_version()}, Ray {ray.__version__}. Every Ray output is checked "
+      "byte for byte against the plain loop's (clean) or the command's (index).\n")
+print("## Clean (the shipped model)\n")
+print(head)
+print("\n".join(clean))
+# Ray's cost per take: the 1-worker wall less the one-off start, against the
+# same work in one Python process.
+overhead = (walls[1] - ray_start - py_wall) / n
+print(f"\nRay's start and stop cost {ray_start:.1f} s once per run. With 1 worker, Ray adds "
+      f"{overhead * 1000:.0f} ms a take over the Python loop (the wall less the start, against the "
+      f"loop); the take itself spends {in_task[1] / n * 1000:.0f} ms in its task against "
+      f"{py_wall / n * 1000:.0f} ms in the loop.")
+print("\n## Index (`--labels-from-name bandai-content`, 100 trees)\n")
+print(head)
+print("\n".join(index))
 
 # The projection, from the measured time a take spends in its task with 2
-# workers (Ray's start-up left out: it is paid once per run).
-per_core = seconds / rates[2]  # seconds of motion cleaned per core-second
+# workers (both cores busy; Ray's start left out: it is paid once per run).
+per_core = seconds / in_task[2]  # seconds of motion cleaned per core-second
 core_hours = 1000 * 3600 / per_core / 3600
-print(f"\n## Projection for 1,000 hours of capture (on paper, from the row above)\n")
-print(f"With 2 workers a take spent {rates[2] / len(takes):.2f} s in its task: {per_core:.1f} s of motion "
+print("\n## Projection for 1,000 hours of capture (on paper, from the rows above)\n")
+print(f"With 2 workers a take spent {in_task[2] / n:.3f} s in its task: {per_core:.1f} s of motion "
       f"cleaned per core-second, so 1,000 hours of capture need about {core_hours:.0f} core-hours: "
-      + ", ".join(f"{core_hours / (16 * n):.1f} h on {n} node{'s' if n > 1 else ''} of 16 cores"
-                  for n in (1, 8, 32))
-      + ", if the takes scale as independent tasks do and storage keeps up. "
-      "Indexing is not in the batch layer yet.")
+      + ", ".join(f"{core_hours / (16 * k):.1f} h on {k} node{'s' if k > 1 else ''} of 16 cores"
+                  for k in (1, 8, 32))
+      + ", if the takes scale as independent tasks do and storage keeps up.")
+print(f"Indexing computes features on the cluster and trains one forest on the driver; "
+      f"its per-clip cost is in the index table, and the forest's training grows with the "
+      f"number of clips, not with the nodes.")
 shutil.rmtree(work, ignore_errors=True)

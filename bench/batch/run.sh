@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# mocap.batch against plain loops on Bandai takes with the shipped model
-# (bench/results/batch.md): the CLI per take, mocap.clean in one Python
-# process, and mocap.batch.clean on a local Ray with 1 and 2 workers; then
-# a projection for 1,000 hours. A release wheel with Ray in its own venv.
-#   bench/batch/run.sh [TAKES]      (default 8; needs ../shared/data)
+# mocap.batch against plain loops on the Bandai takes (bench/results/batch.md):
+# clean with the shipped model (the CLI per take, mocap.clean in one Python
+# process, mocap.batch.clean on a local Ray with 1 and 2 workers), the
+# index (mocap search index against mocap.batch.index), and a projection
+# for 1,000 hours. A release wheel with Ray in its own venv.
+#   bench/batch/run.sh [TAKES]   (default all 1,165, about 40 min on 2 cores;
+#                                 a number takes the first N; needs ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-target}"
-data="${MOCAP_SHARED_DATA:-../shared/data}/bandai/dataset-1"
-takes="${1:-8}"
+data="${MOCAP_SHARED_DATA:-../shared/data}/bandai"
+takes="${1:-all}"
 out=bench/results/batch.md
 
 venv="$target/py-bench-venv"
@@ -30,7 +32,7 @@ table=$(cd /tmp && "$venv/bin/python" "$script" "$data" "$takes" "$cli")
 {
     echo "# mocap.batch: takes/s on a local Ray"
     echo
-    echo "Made by \`bench/batch/run.sh $takes\` ($(date -u +%Y-%m-%d), $(git rev-parse --short HEAD), $(nproc) cores,"
+    echo "Made by \`bench/batch/run.sh${1:+ $1}\` ($(date -u +%Y-%m-%d), $(git rev-parse --short HEAD), $(nproc) cores,"
     echo "load average $(cut -d' ' -f1 /proc/loadavg) at the end); the release wheel and the release CLI."
     echo
     echo "$table"

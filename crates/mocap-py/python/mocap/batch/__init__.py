@@ -241,6 +241,18 @@ def _test_hook(stage: str, source: str) -> None:
         time.sleep(delay)
 
 
+def _one_thread_per_task() -> None:
+    """A task reserves one CPU, but mocap's Rust code runs on rayon, whose
+    pool takes every core of the node: with a task per core, the threads
+    would oversubscribe the node (a Bandai take cleaned with 2 threads costs
+    1.29 CPU-seconds, with 1 thread 1.06). Ray does the same for OpenMP
+    (OMP_NUM_THREADS). The pool reads RAYON_NUM_THREADS when a process
+    first uses it; a value set for the cluster is kept. The results do not
+    depend on the number of threads (the tests compare them byte for byte
+    with the caller's)."""
+    os.environ.setdefault("RAYON_NUM_THREADS", "1")
+
+
 def _mean_rotation_change(before: Any, after: Any) -> Optional[float]:
     """Mean absolute change of the rotation channels, in degrees."""
     import numpy as np
@@ -260,6 +272,7 @@ def process_take(op: str, source: str, target: str, options: dict[str, Any]) -> 
     is returned in it, not raised. What each Ray task runs."""
     import mocap
 
+    _one_thread_per_task()
     start = time.perf_counter()
     record: dict[str, Any] = {"input": source, "output": target, "status": "error"}
     try:
@@ -531,6 +544,7 @@ def clip_features(path: str) -> dict[str, Any]:
     :func:`index` runs). An error is returned in the record, not raised."""
     from mocap import _mocap
 
+    _one_thread_per_task()
     start = time.perf_counter()
     record: dict[str, Any] = {"input": path, "status": "error", "op": "index"}
     try:
