@@ -25,12 +25,17 @@ mkdir -p "$OUT_DIR"
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-# Blender's glTF importer needs numpy in Blender's Python (Debian's).
-if ! command -v blender >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1 \
-    || ! /usr/bin/python3 -c "import numpy" >/dev/null 2>&1; then
-    echo "== installing blender, python3-numpy, nodejs and npm (Debian packages)"
+# Blender's glTF importer needs numpy in Blender's Python (Debian's). Only
+# what is missing is installed: a machine's Node.js may come from elsewhere
+# (NodeSource's nodejs bundles npm, and Debian's npm conflicts with it).
+packages=()
+command -v blender >/dev/null 2>&1 || packages+=(blender)
+/usr/bin/python3 -c "import numpy" >/dev/null 2>&1 || packages+=(python3-numpy)
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+if [ ${#packages[@]} -gt 0 ]; then
+    echo "== installing ${packages[*]} (Debian packages)"
     $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq blender python3-numpy nodejs npm >/dev/null
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${packages[@]}" >/dev/null
 fi
 TOOLS="$TARGET_DIR/gltf-tools"
 if [ ! -d "$TOOLS/node_modules/gltf-validator" ]; then
