@@ -131,7 +131,8 @@ print(f"With 2 workers a take spent {in_task[2] / n:.3f} s in its task: {per_cor
 index_core_hours = 1000 * 3600 / (seconds / index_task[2]) / 3600
 print(f"Indexing: the clips' features took {index_task[2]:.1f} core-seconds in their tasks "
       f"for {seconds / 60:.0f} min of motion, so 1,000 hours need about {index_core_hours:.2f} "
-      "core-hours on the cluster; reading the files dominates, so storage sets the pace. The forest "
+      "core-hours on the cluster: the storage that serves the files is likely to set the pace, not the "
+      "cores. The forest "
       "is trained once, on the driver, on every clip: its time grows with the number of clips "
       "whatever the nodes, and was not measured beyond these.")
 shutil.rmtree(work, ignore_errors=True)
