@@ -8,19 +8,10 @@
 
 use mocap_core::bodymap::BodyMap;
 use mocap_core::io::bvh::read_bvh;
-use mocap_feet::{plant_feet, ContactOptions, FeetOptions};
+use mocap_feet::plant_feet;
+use mocap_studies::feet::{with_thresholds, CONTACT_THRESHOLDS};
 
 type Error = Box<dyn std::error::Error>;
-
-/// (enter height, leave height, enter speed, leave speed); the first is the
-/// stage's default.
-const THRESHOLDS: [(f32, f32, f32, f32); 5] = [
-    (0.04, 0.07, 0.6, 1.0),
-    (0.06, 0.09, 0.6, 1.0),
-    (0.04, 0.07, 0.9, 1.3),
-    (0.06, 0.09, 0.9, 1.3),
-    (0.08, 0.11, 1.2, 1.6),
-];
 
 fn main() -> Result<(), Error> {
     let paths: Vec<String> = std::env::args().skip(1).collect();
@@ -32,17 +23,9 @@ fn main() -> Result<(), Error> {
     for path in &paths {
         let take = read_bvh(path.as_ref())?;
         let map = BodyMap::detect(take.skeleton())?;
-        for (enter_height, leave_height, enter_speed, leave_speed) in THRESHOLDS {
-            let options = FeetOptions {
-                contacts: ContactOptions {
-                    enter_height,
-                    leave_height,
-                    enter_speed,
-                    leave_speed,
-                    ..Default::default()
-                },
-                ..Default::default()
-            };
+        for thresholds in CONTACT_THRESHOLDS {
+            let (enter_height, leave_height, enter_speed, leave_speed) = thresholds;
+            let options = with_thresholds(thresholds);
             let (_, report) = plant_feet(&take, &map, &options)?;
             println!(
                 "| {path} | {enter_height}/{leave_height} | {enter_speed}/{leave_speed} | {} + {} of {} | {:.1} → {:.1} |",

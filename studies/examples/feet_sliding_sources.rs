@@ -17,18 +17,10 @@ use mocap_core::bodymap::BodyMap;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::metrics::{flat_foot_steps, foot_joints};
 use mocap_core::{forward_kinematics, GlobalPoses};
-use mocap_feet::{plant_feet, ContactOptions, FeetOptions};
+use mocap_feet::plant_feet;
+use mocap_studies::feet::{with_thresholds, CONTACT_THRESHOLDS};
 
 type Error = Box<dyn std::error::Error>;
-
-/// Contact thresholds tried (enter height, leave height in leg lengths;
-/// enter speed, leave speed in leg lengths per second); the first is the
-/// stage's default, the last the loosest of `feet_contact_thresholds`.
-const THRESHOLDS: [(f32, f32, f32, f32); 3] = [
-    (0.04, 0.07, 0.6, 1.0),
-    (0.06, 0.09, 0.9, 1.3),
-    (0.08, 0.11, 1.2, 1.6),
-];
 
 /// The frame shift `k` (take frame `f` is truth frame `f + k`, |k| <= 3)
 /// that brings the take's joints nearest the truth's, on average.
@@ -119,17 +111,10 @@ fn main() -> Result<(), Error> {
         let before = forward_kinematics(&take);
         let truth_poses = forward_kinematics(&truth);
         let shift = frame_shift(&before, &truth_poses);
-        for (enter_height, leave_height, enter_speed, leave_speed) in THRESHOLDS {
-            let options = FeetOptions {
-                contacts: ContactOptions {
-                    enter_height,
-                    leave_height,
-                    enter_speed,
-                    leave_speed,
-                    ..Default::default()
-                },
-                ..Default::default()
-            };
+        // The default, the middle and the loosest thresholds.
+        for thresholds in [0, 3, 4].map(|i| CONTACT_THRESHOLDS[i]) {
+            let (enter_height, leave_height, enter_speed, leave_speed) = thresholds;
+            let options = with_thresholds(thresholds);
             let (planted, report) = plant_feet(&take, &map, &options)?;
             let up = report.floor.up();
             let leg = report.before.leg_length;

@@ -3,4 +3,5 @@
 //! doors, and what each study taught is written in `docs/research/`.
 
 pub mod clean;
+pub mod feet;
 pub mod style;
