@@ -5,11 +5,12 @@
 //! 2. Per foot contact, the horizontal correction that holds the foot
 //!    still: frame after frame, the foot is moved back by the step of its
 //!    slowest joint on the ground (the heel while the foot lands, the ball
-//!    while the heel lifts: the joint the foot pivots about), taken as the
-//!    median of the steps around it inside the contact (a real foot moves
-//!    as it lands and lifts off, a sliding one all along), less
+//!    while the heel lifts: the joint the foot pivots about), less
 //!    [`FeetOptions::keep_speed`] (a real planted foot's few centimetres a
-//!    second are kept). The corrections are summed, smoothed at high frame
+//!    second are kept). Inside the contact that is the frame's own step, so
+//!    a captured slide and a fused foot's frame-to-frame jitter are both
+//!    taken away; near its ends (a real foot moves as it lands and lifts
+//!    off) it is the median of the inner steps nearest it. The corrections are summed, smoothed at high frame
 //!    rates (a gaussian of 33 ms) and centred on the
 //!    contact (the foot held where it was on average), and eased in before
 //!    and out after the contact over [`FeetOptions::ease_seconds`]
@@ -284,8 +285,17 @@ fn pin_offsets(take: &TakeFeet, side: usize, leg: &Leg, keep_step: f32, ease: us
         let mut d = Vec3::ZERO;
         let mut held = Vec::with_capacity(span.len());
         held.push(d);
+        let inner = inner_steps(steps.len(), edge);
         for i in 0..steps.len() {
-            let step = robust_step(&steps, i, edge, radius);
+            // The frame's own step inside: its median would keep a fused
+            // foot's jitter, whose median is near zero
+            // (docs/research/feet.md, "Where the sliding on fused takes
+            // comes from").
+            let step = if inner.contains(&i) {
+                steps[i]
+            } else {
+                robust_step(&steps, i, edge, radius)
+            };
             let length = step.length();
             if length > keep_step {
                 d -= step * (1.0 - keep_step / length);
@@ -410,19 +420,25 @@ const STEP_MEDIAN_SECONDS: f32 = 0.1;
 /// frame rate makes larger against the kept speed.
 const HELD_SMOOTHING_SECONDS: f32 = 0.033;
 
-/// The step of a contact's pivot into frame `i + 1` as the stage corrects
-/// it: the median (per coordinate) of the steps within
-/// [`STEP_MEDIAN_SECONDS`] of it (`radius` frames), among the contact's inner steps (not the
-/// [`CONTACT_EDGE_SECONDS`] first and last, `edge` frames; a step near an end takes the nearest
-/// inner ones). A planted foot that slides slides over the whole contact;
-/// a real one moves only as it lands and lifts off.
-fn robust_step(steps: &[Vec3], i: usize, edge: usize, radius: usize) -> Vec3 {
-    let n = steps.len();
-    let (lo, hi) = if n > 2 * edge + 1 {
-        (edge, n - edge)
+/// The inner steps of a contact of `n` steps: all but the `edge` first and
+/// last ([`CONTACT_EDGE_SECONDS`]), or all of a contact too short for that.
+fn inner_steps(n: usize, edge: usize) -> std::ops::Range<usize> {
+    if n > 2 * edge + 1 {
+        edge..n - edge
     } else {
-        (0, n)
-    };
+        0..n
+    }
+}
+
+/// The step of a contact's pivot into frame `i + 1` as the stage corrects
+/// it near the contact's ends: the median (per coordinate) of the steps
+/// within [`STEP_MEDIAN_SECONDS`] of it (`radius` frames), among the
+/// contact's inner steps ([`inner_steps`]: a step near an end takes the
+/// nearest inner ones). A planted foot that slides slides over the whole
+/// contact; a real one moves only as it lands and lifts off.
+fn robust_step(steps: &[Vec3], i: usize, edge: usize, radius: usize) -> Vec3 {
+    let inner = inner_steps(steps.len(), edge);
+    let (lo, hi) = (inner.start, inner.end);
     let centre = i.clamp(lo, hi - 1);
     let window = &steps[centre.saturating_sub(radius).max(lo)..(centre + radius + 1).min(hi)];
     let median = |axis: usize| {
