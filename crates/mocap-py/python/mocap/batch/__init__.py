@@ -410,7 +410,9 @@ def _run(
     bar = _Progress(op, len(jobs), skipped, progress)
     try:
         if todo:
-            _drive(op, todo, options, manifest_path, max_retries, result, bar)
+            jobs = [({"input": src, "output": dst}, (op, src, dst, options)) for src, dst in todo]
+            with open(manifest_path, "a", encoding="utf-8") as log:
+                _drive(op, process_take, jobs, log, max_retries, result, bar)
     finally:
         if owned:
             _import_ray().shutdown()
@@ -421,50 +423,58 @@ def _run(
 
 def _drive(
     op: str,
-    todo: list[tuple[str, str]],
-    options: dict[str, Any],
-    manifest_path: Path,
+    function: Any,
+    jobs: list[tuple[dict[str, Any], tuple]],
+    log: Any,
     max_retries: int,
     result: BatchResult,
     bar: _Progress,
+    keep: Optional[Any] = None,
 ) -> None:
+    """Runs ``function(*args)`` as one Ray task per ``(record, args)`` of
+    ``jobs``; each returns its manifest record. ``record`` (the input, and
+    the output if any) starts the error record of a task whose retries ran
+    out. Each record is written to ``log`` as it arrives and counted in
+    ``result`` and ``bar``; ``keep(record)`` sees every record that is done
+    before it is written (to take what is not for the manifest out of it)."""
     ray = _import_ray()
-    task = ray.remote(num_cpus=1, max_retries=max_retries)(process_take)
+    task = ray.remote(num_cpus=1, max_retries=max_retries)(function)
     # Bounded in-flight tasks: an archive of 100,000 takes is not submitted at once.
     window = max(16, 4 * int(ray.cluster_resources().get("CPU", 1)))
-    pending: dict[Any, tuple[str, str]] = {}
-    queue = iter(todo)
-    with open(manifest_path, "a", encoding="utf-8") as log:
-        while True:
-            while len(pending) < window:
-                job = next(queue, None)
-                if job is None:
-                    break
-                pending[task.remote(op, job[0], job[1], options)] = job
-            if not pending:
+    pending: dict[Any, dict[str, Any]] = {}
+    queue = iter(jobs)
+    while True:
+        while len(pending) < window:
+            job = next(queue, None)
+            if job is None:
                 break
-            ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
-            for ref in ready:
-                source, target = pending.pop(ref)
-                try:
-                    rec = ray.get(ref)
-                except Exception as e:  # the task's retries ran out (a node died each time)
-                    rec = {
-                        "input": source, "output": target, "status": "error",
-                        "error": f"{type(e).__name__}: {e}".splitlines()[0],
-                        "frames": None, "seconds": None,
-                    }
-                rec["op"] = op
-                log.write(json.dumps(rec) + "\n")
-                log.flush()
-                if rec["status"] == "done":
-                    result.done += 1
-                    bar.done += 1
-                else:
-                    result.failed += 1
-                    bar.failed += 1
-                    result.errors.append((source, rec.get("error") or ""))
-            bar.update()
+            pending[task.remote(*job[1])] = job[0]
+        if not pending:
+            break
+        ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
+        for ref in ready:
+            base = pending.pop(ref)
+            try:
+                rec = ray.get(ref)
+            except Exception as e:  # the task's retries ran out (a node died each time)
+                rec = {
+                    **base, "status": "error",
+                    "error": f"{type(e).__name__}: {e}".splitlines()[0],
+                    "frames": None, "seconds": None,
+                }
+            rec["op"] = op
+            if rec["status"] == "done":
+                if keep:
+                    keep(rec)
+                result.done += 1
+                bar.done += 1
+            else:
+                result.failed += 1
+                bar.failed += 1
+                result.errors.append((base["input"], rec.get("error") or ""))
+            log.write(json.dumps(rec) + "\n")
+            log.flush()
+        bar.update()
 
 
 def clean(
@@ -612,40 +622,14 @@ def index(
                          manifest=manifest_path, output_dir=output.parent)
     bar = _Progress("index", len(clips), 0, progress)
     features: dict[str, tuple[Any, float]] = {}
+
+    def keep(rec: dict[str, Any]) -> None:
+        features[rec["input"]] = (rec.pop("values"), rec.pop("fps"))
+
     try:
-        ray = _import_ray()
-        task = ray.remote(num_cpus=1, max_retries=max_retries)(clip_features)
-        window = max(16, 4 * int(ray.cluster_resources().get("CPU", 1)))
-        pending: dict[Any, str] = {}
-        queue = iter(str(path) for path, _, _ in clips)
+        jobs = [({"input": str(path)}, (str(path),)) for path, _, _ in clips]
         with open(manifest_path, "w", encoding="utf-8") as log:
-            while True:
-                while len(pending) < window:
-                    path = next(queue, None)
-                    if path is None:
-                        break
-                    pending[task.remote(path)] = path
-                if not pending:
-                    break
-                ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
-                for ref in ready:
-                    path = pending.pop(ref)
-                    try:
-                        rec = ray.get(ref)
-                    except Exception as e:  # retries ran out (a node died each time)
-                        rec = {"input": path, "status": "error", "op": "index",
-                               "error": f"{type(e).__name__}: {e}".splitlines()[0]}
-                    if rec["status"] == "done":
-                        features[path] = (rec.pop("values"), rec.pop("fps"))
-                        result.done += 1
-                        bar.done += 1
-                    else:
-                        result.failed += 1
-                        bar.failed += 1
-                        result.errors.append((path, rec.get("error") or ""))
-                    log.write(json.dumps(rec) + "\n")
-                    log.flush()
-                bar.update()
+            _drive("index", clip_features, jobs, log, max_retries, result, bar, keep)
     finally:
         if owned:
             _import_ray().shutdown()
