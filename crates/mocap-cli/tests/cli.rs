@@ -2,25 +2,17 @@
 
 use mocap_testdata::shared_data;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
 use mocap_core::io::asf_amc::read_asf_amc;
 use mocap_core::io::bvh::read_bvh;
 use mocap_core::{forward_kinematics, metrics};
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
+mod common;
+use common::{mocap, stderr};
 
 fn sample() -> String {
     mocap_testdata::sample_walk().display().to_string()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]

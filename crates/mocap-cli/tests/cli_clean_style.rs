@@ -2,22 +2,14 @@
 //! training, a few real Bandai takes when `../shared/data` is present).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use mocap_core::io::bvh::{read_bvh, write_bvh};
 use mocap_core::rotation::Vec3;
 use mocap_style::{foot_skating, planted_foot_sliding, RigLayout};
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{mocap, stderr};
 
 fn sample(name: &str) -> String {
     mocap_testdata::sample(name).display().to_string()

@@ -7,19 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
+mod common;
+use common::{mocap, stderr};
 
 fn sample() -> String {
     mocap_testdata::sample_walk().display().to_string()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 fn json(out: &Output) -> serde_json::Value {

@@ -2,14 +2,10 @@
 //! files, calibrated from the body or by a given calibration file.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
+mod common;
+use common::mocap;
 
 fn path(p: &Path) -> &str {
     p.to_str().expect("utf-8 temp path")

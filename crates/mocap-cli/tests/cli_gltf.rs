@@ -2,21 +2,12 @@
 //! scaled, and every command reads it.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use mocap_core::forward_kinematics;
 use mocap_core::io::bvh::read_bvh;
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{mocap, stderr};
 
 fn text(path: &Path) -> &str {
     path.to_str().unwrap()

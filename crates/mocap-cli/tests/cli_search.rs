@@ -1,14 +1,9 @@
 //! `mocap search` end to end on a small real library.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn mocap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mocap"))
-        .args(args)
-        .output()
-        .expect("the mocap binary runs")
-}
+mod common;
+use common::mocap;
 
 fn bandai() -> Option<PathBuf> {
     mocap_testdata::shared("bandai/dataset-2")
