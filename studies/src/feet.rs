@@ -2,10 +2,11 @@
 
 use mocap_feet::{ContactOptions, FeetOptions};
 
-/// Contact thresholds tried, from the stage's default (first) to the
-/// loosest: enter and leave heights in leg lengths above the foot joint's
+/// Contact thresholds tried: the stage's default (first), then from the
+/// strictest to the loosest: enter and leave heights in leg lengths above the foot joint's
 /// lowest, enter and leave speeds in leg lengths per second.
-pub const CONTACT_THRESHOLDS: [(f32, f32, f32, f32); 5] = [
+pub const CONTACT_THRESHOLDS: [(f32, f32, f32, f32); 6] = [
+    (0.05, 0.08, 1.0, 1.4),
     (0.04, 0.07, 0.6, 1.0),
     (0.06, 0.09, 0.6, 1.0),
     (0.04, 0.07, 0.9, 1.3),

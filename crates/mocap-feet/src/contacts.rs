@@ -12,10 +12,12 @@
 //! dropped. Lengths are fractions of the leg length and speeds leg lengths
 //! per second, so the same settings hold for every rig and unit.
 //!
-//! The speed thresholds are generous (a planted foot of a real take stands
+//! The thresholds are generous (a planted foot of a real take stands
 //! still, a swinging one moves at two to four times the body's speed), so
 //! that a planted foot that slides, the fault the stage repairs, is still
-//! found: a 40 cm/s drag is half a leg per second.
+//! found: the stance feet of a cleaned fused take drag at up to a leg a
+//! second (80 cm/s on the Bandai rig) and stand 3-8% of the leg above
+//! their lowest (docs/research/feet.md, "Contacts on fused takes").
 //!
 //! The floor: each kind of foot joint (ankles, toes) rests at one height on
 //! the floor, the same for both feet; it is the [`FLOOR_QUANTILE`] of the
@@ -46,10 +48,10 @@ pub struct ContactOptions {
 impl Default for ContactOptions {
     fn default() -> Self {
         ContactOptions {
-            enter_height: 0.04,
-            leave_height: 0.07,
-            enter_speed: 0.6,
-            leave_speed: 1.0,
+            enter_height: 0.05,
+            leave_height: 0.08,
+            enter_speed: 1.0,
+            leave_speed: 1.4,
             min_seconds: 0.1,
         }
     }
