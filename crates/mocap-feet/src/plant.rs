@@ -25,7 +25,7 @@
 //!    ([`FeetOptions::reach`] of the leg, or the input's own stretch when
 //!    that is more), the root is lowered along up just enough (smoothed the
 //!    same way, at most [`FeetOptions::max_root_drop`]); what lowering
-//!    cannot reach is shortened along the correction.
+//!    cannot reach is shortened, the horizontal pin before the lift.
 //! 5. Each leg is turned by two-bone IK
 //!    ([`mocap_core::kinematics::two_bone_ik`]) so its ankle reaches the
 //!    target; the ankle keeps its global orientation (the foot and toes
@@ -218,7 +218,16 @@ pub fn plant_feet(
             let mut target = take.poses.position(f, leg.ankle) + shift;
             let reach = reach_of(f, leg);
             if (target - h).length() > reach {
-                target = a + (target - a) * within_reach(a - h, target - a, reach);
+                // Shortened, the pin gives way before the lift: a foot
+                // out of the floor matters more than one held still.
+                let wanted = target - a;
+                let lifted = a + up * wanted.dot(up);
+                target = if (lifted - h).length() <= reach {
+                    let pin = wanted.reject_from_normalized(up);
+                    lifted + pin * within_reach(lifted - h, pin, reach)
+                } else {
+                    a + wanted * within_reach(a - h, wanted, reach)
+                };
                 out_of_reach += 1;
             }
             let Some((turn_hip, turn_knee)) = two_bone_ik(h, k, a, target) else {
