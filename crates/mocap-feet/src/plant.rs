@@ -218,16 +218,7 @@ pub fn plant_feet(
             let mut target = take.poses.position(f, leg.ankle) + shift;
             let reach = reach_of(f, leg);
             if (target - h).length() > reach {
-                // Shortened, the pin gives way before the lift: a foot
-                // out of the floor matters more than one held still.
-                let wanted = target - a;
-                let lifted = a + up * wanted.dot(up);
-                target = if (lifted - h).length() <= reach {
-                    let pin = wanted.reject_from_normalized(up);
-                    lifted + pin * within_reach(lifted - h, pin, reach)
-                } else {
-                    a + wanted * within_reach(a - h, wanted, reach)
-                };
+                target = shortened_to_reach(h, a, target, up, reach);
                 out_of_reach += 1;
             }
             let Some((turn_hip, turn_knee)) = two_bone_ik(h, k, a, target) else {
@@ -478,6 +469,22 @@ fn drop_to_reach(v: Vec3, up: Vec3, reach: f32, max_drop: f32) -> f32 {
     (-vu - disc.sqrt()).clamp(0.0, max_drop)
 }
 
+/// The ankle target nearest `target` that a leg from hip `h` with its ankle
+/// at `a` reaches (`reach`): the horizontal pin gives way before the lift
+/// along `up`, since a foot out of the floor matters more than one held
+/// still; when the lift alone is out of reach, the whole correction is
+/// shortened.
+fn shortened_to_reach(h: Vec3, a: Vec3, target: Vec3, up: Vec3, reach: f32) -> Vec3 {
+    let wanted = target - a;
+    let lifted = a + up * wanted.dot(up);
+    if (lifted - h).length() <= reach {
+        let pin = wanted.reject_from_normalized(up);
+        lifted + pin * within_reach(lifted - h, pin, reach)
+    } else {
+        a + wanted * within_reach(a - h, wanted, reach)
+    }
+}
+
 /// `values` (non-negative) made smooth without going below them: the
 /// running maximum over `radius` frames each side, then a triangular
 /// average of the same radius (each output averages maxima that all
@@ -556,5 +563,25 @@ mod tests {
         // Acceleration near the ends is small.
         let acc = offset[2] - 2.0 * offset[1] + offset[0];
         assert!(acc.length() < 0.05, "{acc:?}");
+    }
+
+    #[test]
+    fn out_of_reach_the_pin_gives_way_before_the_lift() {
+        let up = Vec3::Y;
+        let (h, a) = (Vec3::new(0.0, 80.0, 0.0), Vec3::new(0.0, 2.0, 0.0));
+        // 3 up out of the floor and 40 sideways: the leg (reach 79.2)
+        // cannot do both.
+        let target = a + Vec3::new(40.0, 3.0, 0.0);
+        let got = shortened_to_reach(h, a, target, up, 79.2);
+        assert!(((got - h).length() - 79.2).abs() < 1e-3, "{got:?}");
+        assert!((got.y - target.y).abs() < 1e-4, "the lift is kept: {got:?}");
+        assert!(got.x > 0.0 && got.x < 40.0);
+        // The move along up alone is out of reach too (down, here): the
+        // whole correction is shortened along itself.
+        let deep = a + Vec3::new(30.0, -5.0, 0.0);
+        let got = shortened_to_reach(h, a, deep, up, 79.2);
+        assert!(((got - h).length() - 79.2).abs() < 1e-3, "{got:?}");
+        let along = (got - a).normalize().dot((deep - a).normalize());
+        assert!(along > 0.9999, "along the correction: {got:?}");
     }
 }
