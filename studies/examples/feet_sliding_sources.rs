@@ -19,31 +19,9 @@ use mocap_core::metrics::{flat_foot_steps, foot_joints};
 use mocap_core::{forward_kinematics, GlobalPoses};
 use mocap_feet::plant_feet;
 use mocap_studies::feet::{with_thresholds, CONTACT_THRESHOLDS};
+use mocap_studies::frames::frame_shift;
 
 type Error = Box<dyn std::error::Error>;
-
-/// The frame shift `k` (take frame `f` is truth frame `f + k`, |k| <= 3)
-/// that brings the take's joints nearest the truth's, on average.
-fn frame_shift(take: &GlobalPoses, truth: &GlobalPoses) -> isize {
-    let joints = take.joint_count.min(truth.joint_count);
-    let cost = |k: isize| {
-        let (mut sum, mut n) = (0.0f32, 0usize);
-        for f in 0..take.frame_count as isize {
-            let g = f + k;
-            if g < 0 || g >= truth.frame_count as isize {
-                continue;
-            }
-            for j in 0..joints {
-                sum += (take.position(f as usize, j) - truth.position(g as usize, j)).length();
-                n += 1;
-            }
-        }
-        sum / n.max(1) as f32
-    };
-    (-3..=3)
-        .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
-        .unwrap()
-}
 
 /// `steps` (entry `g - 1` for the step `g - 1 -> g` of the truth) as steps
 /// of the take, whose frame `f` is the truth's `f + shift`.
@@ -111,8 +89,8 @@ fn main() -> Result<(), Error> {
         let before = forward_kinematics(&take);
         let truth_poses = forward_kinematics(&truth);
         let shift = frame_shift(&before, &truth_poses);
-        // The default, the middle and the loosest thresholds.
-        for thresholds in [0, 3, 4].map(|i| CONTACT_THRESHOLDS[i]) {
+        // The stage's, the former default and the loosest thresholds.
+        for thresholds in [0, 1, CONTACT_THRESHOLDS.len() - 1].map(|i| CONTACT_THRESHOLDS[i]) {
             let (enter_height, leave_height, enter_speed, leave_speed) = thresholds;
             let options = with_thresholds(thresholds);
             let (planted, report) = plant_feet(&take, &map, &options)?;

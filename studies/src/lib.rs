@@ -4,4 +4,5 @@
 
 pub mod clean;
 pub mod feet;
+pub mod frames;
 pub mod style;
