@@ -7,8 +7,10 @@
 //! twists are the fitter's guess. This study splits each joint's local
 //! rotation into its swing (where the bone to its only child points) and its
 //! twist (about that bone), `q = swing * twist`, and measures the model on
-//! the take with the truth's twists put in, with the truth's swings put in,
-//! and on both with every such twist taken out.
+//! the take with parts of the truth put in: its twists (in each joint's
+//! frame, or in the world with the take's bones kept), its swings, its
+//! pelvis and chest, its end joints (hands, head, toes); and on both with
+//! every twist taken out. docs/research/style.md, "Fused takes".
 //!
 //! cargo run --release -p mocap-studies --example style_fused_twist -- MODEL TAKE.bvh TRUTH.bvh [TAKE TRUTH]...
 //!
@@ -19,7 +21,7 @@ use mocap_core::io::bvh::read_bvh;
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, Motion};
 use mocap_studies::frames::frame_shift;
-use mocap_style::{fill_unseen_rotations, load_model, source_reconstruction_deg};
+use mocap_style::{load_model, source_reconstruction_deg};
 
 type Error = Box<dyn std::error::Error>;
 
@@ -161,33 +163,14 @@ fn twist_and_swing_error(take: &Motion, truth: &Motion, shift: isize) -> (f32, f
     )
 }
 
-/// Mean angle (degrees) between the take's and the truth's local
-/// rotations, over every joint and frame.
-fn rotation_error(take: &Motion, truth: &Motion, shift: isize) -> f32 {
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for f in 0..take.frame_count() {
-        let g = f as isize + shift;
-        if g < 0 || g >= truth.frame_count() as isize {
-            continue;
-        }
-        for j in 0..take.skeleton().joint_count() {
-            sum += take
-                .local_rotation(f, j)
-                .angle_between(truth.local_rotation(g as usize, j)) as f64;
-            n += 1;
-        }
-    }
-    (sum / n.max(1) as f64).to_degrees() as f32
-}
-
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 || !(args.len() - 1).is_multiple_of(2) {
         return Err("MODEL TAKE.bvh TRUTH.bvh [TAKE TRUTH]...".into());
     }
     let model = load_model(Some(args[0].as_ref()), Default::default())?;
-    println!("| take | twist error (deg) | swing error (deg) | truth | take | take, the truth's twists | take, the truth's swings | take, no twist | truth, no twist | take, the truth's branching joints | take's bones, the truth's twists in the world | take, the truth's end joints | both | take filled by the model (1 / 3 rounds) | rotation error against the truth: take → filled (1 / 3 rounds) |");
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!("| take | twist error (deg) | swing error (deg) | truth | take | take, the truth's twists | take, the truth's swings | take, no twist | truth, no twist | take, the truth's branching joints | take's bones, the truth's twists in the world | take, the truth's end joints | both |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for pair in args[1..].chunks(2) {
         let (take, truth) = (read_bvh(pair[0].as_ref())?, read_bvh(pair[1].as_ref())?);
         if take.skeleton().joint_count() != truth.skeleton().joint_count() {
@@ -196,10 +179,8 @@ fn main() -> Result<(), Error> {
         let shift = frame_shift(&forward_kinematics(&take), &forward_kinematics(&truth));
         let (twist, swing) = twist_and_swing_error(&take, &truth, shift);
         let reconstruct = |m: &Motion| source_reconstruction_deg(&model, m);
-        let (once, _) = fill_unseen_rotations(&model, &take, 1)?;
-        let (thrice, fill) = fill_unseen_rotations(&model, &take, 3)?;
         println!(
-            "| {} | {twist:.1} | {swing:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} / {:.1} | {:.1} → {:.1} / {:.1} |",
+            "| {} | {twist:.1} | {swing:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
             pair[0],
             reconstruct(&truth)?,
             reconstruct(&take)?,
@@ -211,13 +192,7 @@ fn main() -> Result<(), Error> {
             reconstruct(&truth_twist_in_world(&take, &truth, shift))?,
             reconstruct(&with_truth_ends(&take, &truth, shift))?,
             reconstruct(&with_truth_ends(&truth_twist_in_world(&take, &truth, shift), &truth, shift))?,
-            reconstruct(&once)?,
-            reconstruct(&thrice)?,
-            rotation_error(&take, &truth, shift),
-            rotation_error(&once, &truth, shift),
-            rotation_error(&thrice, &truth, shift),
         );
-        eprintln!("{}: filled, 3 rounds: {fill:?}", pair[0]);
     }
     Ok(())
 }

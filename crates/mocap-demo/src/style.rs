@@ -73,9 +73,9 @@ pub(crate) fn run(context: &StageContext, report: &mut StageReport) -> StageResu
         report.note(format!(
             "The model reproduces this take {:.1} degrees off with no style (walks like those it \
              was trained on: about 3-5): the take is unlike the motion it knows, and its content \
-             is likely lost in the output. A likely cause on a fused take: the twist of its limbs \
-             about their bones, which a Kinect skeleton does not see (see the fuse stage's \
-             rotation error).",
+             is likely lost in the output. On a fused take the cause is what a Kinect skeleton \
+             does not see and the fitter guesses: the twist of the limbs about their bones and \
+             the turn of the hands, head and toes (docs/research/style.md, \"Fused takes\").",
             applied.source_reconstruction_deg
         ));
     }

@@ -106,7 +106,6 @@ mod foot_loss;
 mod linalg;
 mod model;
 mod train;
-mod unseen;
 
 // Restyling files and motions.
 pub use apply::{
@@ -120,7 +119,6 @@ pub use convert::{
     windowed_mean, Asymmetry, Conversion, ConvertOptions, Latents, Method, PatchMatch, RootPath,
     StyleMatch,
 };
-pub use unseen::{fill_unseen_rotations, UnseenFill};
 
 // The model and its training.
 pub use features::{gait_period, Normalization, RigLayout};
