@@ -22,6 +22,7 @@ fn info_json_reports_the_sample() {
     let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let first = &info[0];
     assert_eq!(first["frames"], 195);
+    assert_eq!(first["lead_in_frames"], 0);
     assert_eq!(first["joints"], 22);
     assert_eq!(first["channels"], 132);
     assert_eq!(first["frame_time"], 0.0333333);
@@ -77,6 +78,9 @@ fn info_says_how_the_body_parts_were_found() {
     assert_eq!(info[0]["rig"], "Daz/Poser");
     assert_eq!(info[0]["found_by"], "names");
     assert_eq!(info[0]["body_part_joints"]["right_hip"], "rThigh");
+    // The CMU conversions start at the rest pose and blend out of it.
+    assert_eq!(info[0]["lead_in_frames"], 5);
+    assert_eq!(info[1]["lead_in_frames"], 0);
     // No name means anything: the shape. In the file, the CMU rig's
     // `LeftUpLeg` is the third joint and `RightArm` the 26th.
     assert_eq!(info[1]["rig"], "unnamed");
@@ -102,6 +106,8 @@ fn info_says_how_the_body_parts_were_found() {
         "body parts not found",
         "--rig FILE",
         "# left_hip = \"\"",
+        "lead-in    frames 0..5 are the rest pose",
+        "mocap convert --frames 5..",
     ] {
         assert!(text.contains(expected), "{expected}: {text}");
     }

@@ -12,6 +12,7 @@ use crate::error::Result;
 use crate::io::MotionSource;
 use crate::kinematics::bounding_box;
 use crate::motion::Motion;
+use crate::ops::rest_pose_lead_in;
 
 /// What `mocap info` reports about one motion.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -24,6 +25,9 @@ pub struct MotionInfo {
     pub frame_time: f64,
     pub fps: f64,
     pub duration_seconds: f64,
+    /// Frames at the start that hold the skeleton's rest pose and the
+    /// blend out of it rather than the motion ([`rest_pose_lead_in`]).
+    pub lead_in_frames: usize,
     /// Smallest and largest global joint coordinates over the take.
     pub bounding_box: Option<[[f32; 3]; 2]>,
     pub root: String,
@@ -61,6 +65,7 @@ impl MotionInfo {
             frame_time: motion.frame_time(),
             fps: motion.fps(),
             duration_seconds: motion.duration(),
+            lead_in_frames: rest_pose_lead_in(motion),
             bounding_box: bounding_box(motion).map(|(lo, hi)| [lo.to_array(), hi.to_array()]),
             root: skeleton
                 .joints()
@@ -95,6 +100,13 @@ impl MotionInfo {
             "  frames     {} at {:.3} fps (frame time {} s), {:.3} s\n",
             self.frames, self.fps, self.frame_time, self.duration_seconds
         );
+        if self.lead_in_frames > 0 {
+            s += &format!(
+                "  lead-in    frames 0..{k} are the rest pose and the blend out of it \
+                 (`mocap convert --frames {k}..` drops them)\n",
+                k = self.lead_in_frames
+            );
+        }
         if let Some([lo, hi]) = self.bounding_box {
             s += &format!(
                 "  bounds     x {:.2}..{:.2}  y {:.2}..{:.2}  z {:.2}..{:.2}\n",

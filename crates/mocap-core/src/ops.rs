@@ -216,6 +216,94 @@ pub fn trim(motion: &Motion, range: Range<usize>) -> Result<Motion> {
     )
 }
 
+/// How many frames at the start of `motion` are not its motion. Some
+/// exporters put the skeleton's rest pose first (the arms, neck and head at
+/// zero rotation: the CMU conversions for Daz/Poser, a MotionBuilder bind
+/// pose) and blend from it into the motion over the next frames.
+///
+/// 0 unless frame 0 is the rest pose, frame 1 is not, and the step between
+/// them is a jump: some joint moves further than [`LEAD_IN_STEP_FACTOR`]
+/// times the take's median largest step and than [`LEAD_IN_MIN_STEP`] of the
+/// rest pose's size. The lead-in then runs on while the steps are jumps, at
+/// most a quarter second. On the 85 CMU Daz clips in the test data: 5 frames
+/// (4 on runs).
+pub fn rest_pose_lead_in(motion: &Motion) -> usize {
+    let n = motion.frame_count();
+    let skeleton = motion.skeleton();
+    // The arms, the neck and the head, where the body parts are found, else
+    // every joint below the root: a rest pose's legs and spine may be
+    // turned (the CMU conversions' legs by up to 11 degrees, their spines
+    // by 2, per performer) and the pelvis's rotation is where the body
+    // faces.
+    use BodyPart::*;
+    let joints: Vec<usize> = match BodyMap::detect(skeleton) {
+        Ok(map) => [
+            Neck,
+            Head,
+            LeftClavicle,
+            LeftShoulder,
+            LeftElbow,
+            LeftWrist,
+            RightClavicle,
+            RightShoulder,
+            RightElbow,
+            RightWrist,
+        ]
+        .into_iter()
+        .filter_map(|part| map.joint(part))
+        .collect(),
+        Err(_) => (1..skeleton.joint_count()).collect(),
+    };
+    let turned = |f: usize| {
+        joints
+            .iter()
+            .filter(|&&j| j != 0 && skeleton.joint(j).has_rotation_channels())
+            .map(|&j| angle_between(motion.local_rotation(f, j), Quat::IDENTITY))
+            .fold(0.0f32, f32::max)
+    };
+    let rest = LEAD_IN_REST_DEGREES.to_radians();
+    if n < 3 || turned(0) > rest || turned(1) <= rest {
+        return 0;
+    }
+    let poses = forward_kinematics(motion);
+    let joints = poses.joint_count;
+    let steps: Vec<f32> = (0..n - 1)
+        .map(|f| {
+            (0..joints)
+                .map(|j| poses.position(f + 1, j).distance(poses.position(f, j)))
+                .fold(0.0f32, f32::max)
+        })
+        .collect();
+    let mut sorted = steps.clone();
+    sorted.sort_by(|a, b| a.total_cmp(b));
+    let median = sorted[sorted.len() / 2];
+    let (lo, hi) = (0..joints).map(|j| poses.position(0, j)).fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    let size = (hi - lo).length();
+    let threshold = (LEAD_IN_STEP_FACTOR * median).max(LEAD_IN_MIN_STEP * size);
+    let limit = ((0.25 * motion.fps()).round() as usize).max(1);
+    if steps[0] <= threshold {
+        // No jump out of it: a take that starts at rest.
+        return 0;
+    }
+    let mut lead = 1;
+    while lead < steps.len() && lead <= limit && steps[lead] > threshold {
+        lead += 1;
+    }
+    lead.min(n - 1)
+}
+
+/// A frame whose arms, neck and head turn by less than this angle
+/// (degrees) from their rest is the rest pose ([`rest_pose_lead_in`]).
+pub const LEAD_IN_REST_DEGREES: f32 = 1.0;
+/// A lead-in frame's step moves some joint further than this many times the
+/// take's median largest step ([`rest_pose_lead_in`]) ...
+pub const LEAD_IN_STEP_FACTOR: f32 = 2.0;
+/// ... and further than this fraction of the rest pose's size.
+pub const LEAD_IN_MIN_STEP: f32 = 0.02;
+
 /// The motion in other units: offsets, end sites, position channels and
 /// translation limits multiplied by `factor` (e.g. 0.01 for centimetres to
 /// metres). Rotations are unchanged. `factor` should be positive.

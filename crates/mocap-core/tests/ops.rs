@@ -480,3 +480,67 @@ fn bandai_mirrors_keep_midline_rotations_natural() {
         }
     }
 }
+
+#[test]
+fn a_leading_rest_pose_is_found_on_the_cmu_daz_clips_and_nowhere_else() {
+    let Some(data) = shared_data() else {
+        return;
+    };
+    let daz = data.join("other-rigs/cmu-daz");
+    let mut clips = 0;
+    for folder in std::fs::read_dir(&daz).unwrap() {
+        for file in std::fs::read_dir(folder.unwrap().path()).unwrap() {
+            let path = file.unwrap().path();
+            let motion = read_bvh(&path).unwrap();
+            let lead = rest_pose_lead_in(&motion);
+            // Frame 0 is the rest pose, and the motion blends in from it
+            // over four frames (three on runs).
+            // 09_10 holds its root still over frames 1-4 and then pops to
+            // where the motion is: a pop, not the blend this finds.
+            let expected = if path.ends_with("09/09_10.bvh") {
+                1..=1
+            } else {
+                4..=5
+            };
+            assert!(expected.contains(&lead), "{}: {lead}", path.display());
+            clips += 1;
+        }
+    }
+    assert!(clips >= 17, "{clips} clips");
+    assert_eq!(
+        rest_pose_lead_in(&read_bvh(&daz.join("07/07_01.bvh")).unwrap()),
+        5
+    );
+    // Takes that start with their motion.
+    for path in bandai_files(&data, "dataset-1", 50)
+        .into_iter()
+        .chain(bandai_files(&data, "dataset-2", 50))
+        .chain([
+            data.join("other-rigs/cmu-max/131_01.bvh"),
+            data.join("other-rigs/xia/angry_13_000.bvh"),
+            data.join("other-rigs/animated-drawings/fair1/dab.bvh"),
+            data.join("parser-cases/bvhanim_test_mocapbank.bvh"),
+        ])
+    {
+        let motion = read_bvh(&path).unwrap();
+        assert_eq!(rest_pose_lead_in(&motion), 0, "{}", path.display());
+    }
+}
+
+#[test]
+fn a_take_whose_first_frame_is_the_rest_pose_starts_after_it() {
+    // The root turning steadily by 1 degree a frame (the child joint moves
+    // with it) and the child joint turned; then the child's frame 0 zeroed.
+    let mut frames: Vec<[f32; 9]> = (0..40)
+        .map(|f| [0.0, 0.0, 0.0, 30.0 + f as f32, 0.0, 0.0, 20.0, 0.0, 0.0])
+        .collect();
+    assert_eq!(rest_pose_lead_in(&two_joints(&frames)), 0);
+    frames[0] = [0.0; 9];
+    assert_eq!(rest_pose_lead_in(&two_joints(&frames)), 1);
+    // Frames 1 and 2 still on the way from it: part of the lead-in.
+    frames[1][3] = 10.0;
+    frames[2][3] = 20.0;
+    assert_eq!(rest_pose_lead_in(&two_joints(&frames)), 3);
+    // A take at rest throughout has no lead-in.
+    assert_eq!(rest_pose_lead_in(&two_joints(&[[0.0; 9]; 10])), 0);
+}
