@@ -33,12 +33,13 @@
 
 use mocap_core::bodymap::BodyMap;
 use mocap_core::kinematics::{two_bone_ik, within_reach};
+use mocap_core::ops::{self, rest_pose_lead_in};
 use mocap_core::rotation::{Quat, Vec3};
 use mocap_core::{forward_kinematics, GlobalPoses, Motion, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::contacts::ContactOptions;
-use crate::floor::{measure_poses, FeetMeasures, TakeFeet, BELOW_FLOOR_TOLERANCE};
+use crate::floor::{measure_poses, FeetMeasures, TakeFeet, BELOW_FLOOR_TOLERANCE, MIN_FRAMES};
 use crate::ground::Leg;
 
 /// The radius of the running maximum and average that smooth the lift
@@ -98,6 +99,10 @@ pub struct FootReport {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FeetReport {
     pub frames: usize,
+    /// Frames at the start left as they are and not measured: the
+    /// skeleton's rest pose and the blend out of it
+    /// ([`mocap_core::ops::rest_pose_lead_in`]).
+    pub lead_in_frames: usize,
     pub fps: f64,
     /// Left, right.
     pub feet: [FootReport; 2],
@@ -120,7 +125,30 @@ pub struct FeetReport {
 /// module docs), on the same skeleton and channels. `map` locates the legs
 /// (`BodyMap::detect`, or a rig file). Fails, naming what is missing, on a
 /// rig without both legs, the pelvis and the head, and on a take too short.
+///
+/// A take that starts at the skeleton's rest pose and blends out of it
+/// ([`rest_pose_lead_in`]) keeps those frames as they are: they are no
+/// stance, and their feet are not measured either.
 pub fn plant_feet(
+    motion: &Motion,
+    map: &BodyMap,
+    options: &FeetOptions,
+) -> Result<(Motion, FeetReport)> {
+    let n = motion.frame_count();
+    let lead = rest_pose_lead_in(motion);
+    if lead == 0 || n - lead < MIN_FRAMES {
+        return plant_motion(motion, map, options);
+    }
+    let (planted, mut report) = plant_motion(&ops::trim(motion, lead..n)?, map, options)?;
+    let mut out = ops::trim(motion, 0..lead)?;
+    out.append(&planted)?;
+    report.frames = n;
+    report.lead_in_frames = lead;
+    Ok((out, report))
+}
+
+/// [`plant_feet`] on every frame of `motion`.
+fn plant_motion(
     motion: &Motion,
     map: &BodyMap,
     options: &FeetOptions,
@@ -242,6 +270,7 @@ pub fn plant_feet(
         .fold(0.0f32, f32::max);
     let report = FeetReport {
         frames: n,
+        lead_in_frames: 0,
         fps: motion.fps(),
         feet,
         floor: take.floor.clone(),

@@ -167,3 +167,30 @@ fn a_take_too_short_and_a_rig_without_feet_are_refused() {
         assert!(error.contains(part), "{error}");
     }
 }
+
+#[test]
+fn a_take_that_starts_at_the_rest_pose_keeps_those_frames() {
+    let Some(dir) = mocap_testdata::shared("other-rigs/cmu-daz/07") else {
+        return;
+    };
+    // A CMU walk converted for Daz: frame 0 is the rest pose, frames 1-4
+    // blend out of it.
+    let take = read_motion(&dir.join("07_01.bvh")).unwrap();
+    let map = BodyMap::detect(take.skeleton()).unwrap();
+    let (planted, report) = plant_feet(&take, &map, &FeetOptions::default()).unwrap();
+    assert_eq!(report.lead_in_frames, 5);
+    assert_eq!(report.frames, take.frame_count());
+    assert_eq!(planted.frame_count(), take.frame_count());
+    for f in 0..5 {
+        assert_eq!(planted.frame(f), take.frame(f), "frame {f}");
+    }
+    // The rest is planted and measured as the take without its lead-in.
+    let motion = trim(&take, 5..take.frame_count()).unwrap();
+    let (alone, alone_report) = plant_feet(&motion, &map, &FeetOptions::default()).unwrap();
+    assert_eq!(alone_report.lead_in_frames, 0);
+    assert_eq!(report.before, alone_report.before);
+    assert_eq!(report.after, alone_report.after);
+    for f in 0..alone.frame_count() {
+        assert_eq!(planted.frame(f + 5), alone.frame(f), "frame {f}");
+    }
+}

@@ -50,6 +50,12 @@ pub fn run(args: Args, options: &GlobalOptions) -> anyhow::Result<()> {
         r.frames,
         report.rig
     );
+    if r.lead_in_frames > 0 {
+        eprintln!(
+            "frames 0..{} left as they are and not measured: the rest pose and the blend out of it",
+            r.lead_in_frames
+        );
+    }
     for (side, foot) in ["left", "right"].iter().zip(&r.feet) {
         eprintln!(
             "{side} foot: {} contacts over {} frames; {} frames turned, {} lifted out of the floor, \
